@@ -1,0 +1,184 @@
+//! Acceleration structures behind one trait.
+//!
+//! A structure sees only what [`Primitives`] tells it (count, bounds, a leaf intersection
+//! callback), never shapes, materials or files. Every structure answers the same two
+//! questions (pbrt's `Intersect` / `IntersectP`): [`Accel::intersect`] for the closest hit
+//! and [`Accel::occluded`] for any hit (shadow rays), counts its work in per-thread
+//! [`Counters`], reports [`AccelStats`] and can [`Accel::validate`] itself.
+//!
+//! The runtime choice is [`AnyAccel`], a closed enum matched per call: no `dyn` in the hot loop.
+
+pub mod brute;
+pub mod bvh;
+pub mod counters;
+pub mod primitives;
+pub mod stats;
+
+use std::fmt;
+use std::str::FromStr;
+use std::time::Instant;
+
+use raylab_core::Ray;
+
+pub use brute::Brute;
+pub use bvh::{Bvh, SplitMethod};
+pub use counters::Counters;
+pub use primitives::{Hit, PrimHit, Primitives};
+pub use stats::AccelStats;
+
+/// What every acceleration structure offers.
+pub trait Accel: Send + Sync {
+    /// Closest hit with `t` in `(ray.t_min, ray.t_max]`.
+    fn intersect<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, counters: &mut Counters) -> Option<Hit>;
+    /// Whether anything is hit in `(ray.t_min, ray.t_max]`; may stop at the first hit found.
+    fn occluded<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, counters: &mut Counters) -> bool;
+    /// Statistics of the built structure (build time is filled in by [`AnyAccel::build`]).
+    fn stats(&self) -> AccelStats;
+    /// Checks the structure's invariants: every primitive reachable, children inside parents,
+    /// counts consistent.
+    fn validate<P: Primitives + ?Sized>(&self, prims: &P) -> Result<(), ValidationError>;
+}
+
+/// A broken invariant found by [`Accel::validate`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{accel}: {message}")]
+pub struct ValidationError {
+    pub accel: &'static str,
+    pub message: String,
+}
+
+impl ValidationError {
+    pub fn new(accel: &'static str, message: impl Into<String>) -> Self {
+        Self { accel, message: message.into() }
+    }
+}
+
+/// The structures a user can choose by name (`--accel NAME`, `[render] accel`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum AccelKind {
+    /// Every primitive tested: the oracle.
+    None,
+    /// BVH, binned SAH (Wald 2007).
+    Bvh,
+    /// BVH split at the object median of the longest axis.
+    BvhMedian,
+    /// BVH split at the spatial midpoint of the longest axis.
+    BvhMidpoint,
+}
+
+impl AccelKind {
+    pub const ALL: &'static [AccelKind] = &[AccelKind::None, AccelKind::Bvh, AccelKind::BvhMedian, AccelKind::BvhMidpoint];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            AccelKind::None => "none",
+            AccelKind::Bvh => "bvh",
+            AccelKind::BvhMedian => "bvh-median",
+            AccelKind::BvhMidpoint => "bvh-midpoint",
+        }
+    }
+
+    pub fn names() -> String {
+        Self::ALL.iter().map(|k| k.name()).collect::<Vec<_>>().join(", ")
+    }
+}
+
+impl fmt::Display for AccelKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// An unknown structure name; the message lists the valid ones.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("unknown acceleration structure `{0}` (valid: {names})", names = AccelKind::names())]
+pub struct UnknownAccel(pub String);
+
+impl FromStr for AccelKind {
+    type Err = UnknownAccel;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL.iter().copied().find(|k| k.name() == s).ok_or_else(|| UnknownAccel(s.to_string()))
+    }
+}
+
+/// Build parameters shared by the builders; each reads the fields it needs.
+#[derive(Clone, Debug)]
+pub struct BuildOptions {
+    /// Cost of one traversal step relative to one primitive test (SAH).
+    pub traversal_cost: f32,
+    /// Cost of one primitive test.
+    pub intersection_cost: f32,
+    /// Leaves never hold more primitives than this unless they cannot be split.
+    pub max_leaf_size: usize,
+    /// Number of bins of binned builders.
+    pub bins: usize,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        Self { traversal_cost: 1.0, intersection_cost: 1.0, max_leaf_size: 8, bins: 16 }
+    }
+}
+
+/// A built structure of any kind.
+#[derive(Debug)]
+pub enum AnyAccel {
+    None(Brute),
+    Bvh(Bvh),
+}
+
+macro_rules! dispatch {
+    ($self:expr, $a:ident => $e:expr) => {
+        match $self {
+            AnyAccel::None($a) => $e,
+            AnyAccel::Bvh($a) => $e,
+        }
+    };
+}
+
+impl AnyAccel {
+    /// Builds the structure `kind` over `prims` and records the build time in its stats.
+    pub fn build<P: Primitives + ?Sized>(kind: AccelKind, prims: &P, opts: &BuildOptions) -> Self {
+        let start = Instant::now();
+        let mut accel = match kind {
+            AccelKind::None => AnyAccel::None(Brute::build(prims)),
+            AccelKind::Bvh => AnyAccel::Bvh(Bvh::build(prims, SplitMethod::BinnedSah, opts)),
+            AccelKind::BvhMedian => AnyAccel::Bvh(Bvh::build(prims, SplitMethod::Median, opts)),
+            AccelKind::BvhMidpoint => AnyAccel::Bvh(Bvh::build(prims, SplitMethod::Midpoint, opts)),
+        };
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        dispatch!(&mut accel, a => a.build_ms = ms);
+        accel
+    }
+}
+
+impl Accel for AnyAccel {
+    #[inline]
+    fn intersect<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, counters: &mut Counters) -> Option<Hit> {
+        dispatch!(self, a => a.intersect(prims, ray, counters))
+    }
+    #[inline]
+    fn occluded<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, counters: &mut Counters) -> bool {
+        dispatch!(self, a => a.occluded(prims, ray, counters))
+    }
+    fn stats(&self) -> AccelStats {
+        dispatch!(self, a => a.stats())
+    }
+    fn validate<P: Primitives + ?Sized>(&self, prims: &P) -> Result<(), ValidationError> {
+        dispatch!(self, a => a.validate(prims))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_unknown_lists_valid() {
+        for k in AccelKind::ALL {
+            assert_eq!(k.name().parse::<AccelKind>().unwrap(), *k);
+        }
+        let e = "octree".parse::<AccelKind>().unwrap_err();
+        assert_eq!(e.to_string(), format!("unknown acceleration structure `octree` (valid: {})", AccelKind::names()));
+    }
+}

@@ -1,0 +1,65 @@
+use std::ops::Range;
+
+use raylab_core::{Aabb, Ray, Vec3};
+
+/// A hit on one primitive: distance and the primitive's own surface parameters
+/// (barycentrics for triangles, angles for spheres, ...).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PrimHit {
+    pub t: f32,
+    pub u: f32,
+    pub v: f32,
+}
+
+/// A hit found by a structure: which primitive, and where on it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    pub prim: u32,
+    pub u: f32,
+    pub v: f32,
+}
+
+impl Hit {
+    pub fn new(prim: u32, h: PrimHit) -> Self {
+        Self { t: h.t, prim, u: h.u, v: h.v }
+    }
+}
+
+/// What a structure indexes into. Builders read only bounds and centroids; leaves call
+/// `intersect`, which generics inline into the traversal loop.
+pub trait Primitives: Sync {
+    fn len(&self) -> usize;
+
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Bounds of primitive `i`; finite for every `i < len()`.
+    fn bounds(&self, i: u32) -> Aabb;
+
+    fn centroid(&self, i: u32) -> Vec3 {
+        self.bounds(i).centroid()
+    }
+
+    /// Hit with `t` in `(ray.t_min, ray.t_max]`, or `None`.
+    fn intersect(&self, i: u32, ray: &Ray) -> Option<PrimHit>;
+
+    /// Bounds of the part of primitive `i` that lies inside `clip`, for spatial splits
+    /// (kd-tree "perfect splits", SBVH). The default, `bounds ∩ clip`, is conservative;
+    /// triangles override it with exact polygon clipping.
+    fn clipped_bounds(&self, i: u32, clip: &Aabb) -> Aabb {
+        self.bounds(i).intersection(*clip)
+    }
+
+    /// The scene's objects as consecutive ranges of primitive indices (one mesh, one
+    /// sphere, ...), for per-object bounding boxes. Default: one object per primitive.
+    fn objects(&self) -> Vec<Range<u32>> {
+        (0..self.len() as u32).map(|i| i..i + 1).collect()
+    }
+}
+
+/// Bounds of all primitives.
+pub fn total_bounds<P: Primitives + ?Sized>(prims: &P) -> Aabb {
+    (0..prims.len() as u32).fold(Aabb::EMPTY, |b, i| b.union(prims.bounds(i)))
+}

@@ -1,0 +1,109 @@
+//! Every structure against the brute-force oracle, on the same seeded rays: the same
+//! primitive and distance for closest hits, the same answer for any-hit queries.
+
+use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Primitives};
+use raylab_core::{Aabb, Pcg32, Ray, Vec3};
+use raylab_testkit::{self as kit, Prim, Soup};
+
+fn check_all(name: &str, soup: &Soup, rays: &[Ray]) {
+    let oracle = AnyAccel::build(AccelKind::None, soup, &BuildOptions::default());
+    for &kind in AccelKind::ALL {
+        let accel = AnyAccel::build(kind, soup, &BuildOptions::default());
+        accel.validate(soup).unwrap_or_else(|e| panic!("{name}/{kind}: {e}"));
+        let mut c = Counters::default();
+        for (k, ray) in rays.iter().enumerate() {
+            let want = oracle.intersect(soup, ray, &mut c);
+            let got = accel.intersect(soup, ray, &mut c);
+            match (want, got) {
+                (None, None) => {}
+                (Some(w), Some(g)) => {
+                    // Equal distances may come from different primitives (shared edges).
+                    assert!(w.t == g.t, "{name}/{kind} ray {k}: t {} vs oracle {}", g.t, w.t);
+                    if w.prim != g.prim {
+                        let again = soup.intersect(g.prim, ray).map(|h| h.t);
+                        assert_eq!(again, Some(w.t), "{name}/{kind} ray {k}: prim {} vs {}", g.prim, w.prim);
+                    }
+                }
+                _ => panic!("{name}/{kind} ray {k}: {got:?} vs oracle {want:?}"),
+            }
+            assert_eq!(accel.occluded(soup, ray, &mut c), want.is_some(), "{name}/{kind} ray {k}: any hit");
+            let short = Ray { t_max: want.map_or(1.0, |h| h.t * 0.5), ..*ray };
+            assert_eq!(accel.occluded(soup, &short, &mut c), oracle.occluded(soup, &short, &mut c), "{name}/{kind} ray {k}: short any hit");
+        }
+    }
+}
+
+fn unit() -> Aabb {
+    Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0))
+}
+
+#[test]
+fn random_triangle_soups() {
+    let mut rng = Pcg32::new(7, 1);
+    for n in [1, 2, 3, 10, 100, 2000] {
+        let soup = kit::random_triangles(&mut rng, n, &unit(), 0.2);
+        let rays = kit::random_rays(&mut rng, 500, &Aabb::new(Vec3::splat(-2.0), Vec3::splat(2.0)), &unit());
+        check_all(&format!("soup{n}"), &soup, &rays);
+    }
+}
+
+#[test]
+fn spheres_and_triangles_mixed() {
+    let mut rng = Pcg32::new(8, 1);
+    let mut soup = kit::random_spheres(&mut rng, 300, &unit(), 0.1);
+    soup.push_object(kit::random_triangles(&mut rng, 300, &unit(), 0.1));
+    soup.push_object(kit::cube());
+    let rays = kit::random_rays(&mut rng, 1000, &unit(), &unit());
+    check_all("mixed", &soup, &rays);
+}
+
+#[test]
+fn degenerate_inputs() {
+    let mut rng = Pcg32::new(9, 1);
+    let rays = kit::random_rays(&mut rng, 300, &unit(), &unit());
+    check_all("empty", &Soup::default(), &rays);
+    let p = Vec3::new(0.1, 0.2, 0.3);
+    let same: Vec<[Vec3; 3]> = (0..50).map(|k| [p, p + Vec3::X * 0.1 * k as f32, p + Vec3::Y * 0.1]).collect();
+    check_all("equal centroids", &Soup::new(vec![Prim::Sphere { center: p, radius: 0.3 }; 40]), &rays);
+    check_all("fan", &Soup::triangles(same), &rays);
+    let flat: Vec<[Vec3; 3]> = (0..100).map(|k| {
+        let x = k as f32 * 0.02 - 1.0;
+        [Vec3::new(x, 0.0, -1.0), Vec3::new(x + 0.02, 0.0, -1.0), Vec3::new(x, 0.0, 1.0)]
+    }).collect();
+    check_all("flat", &Soup::triangles(flat), &rays);
+    let zero_area: Vec<[Vec3; 3]> = (0..20).map(|k| [Vec3::splat(k as f32 * 0.05); 3]).collect();
+    check_all("zero area", &Soup::triangles(zero_area), &rays);
+    for scale in [1e-4f32, 1e4] {
+        let b = Aabb::new(Vec3::splat(-scale), Vec3::splat(scale));
+        let soup = kit::random_triangles(&mut rng, 500, &b, 0.1 * scale);
+        let rays = kit::random_rays(&mut rng, 300, &b, &b);
+        check_all(&format!("scale {scale}"), &soup, &rays);
+    }
+}
+
+#[test]
+fn cube_axis_rays_through_edges_and_vertices() {
+    let soup = kit::cube();
+    let mut rays = Vec::new();
+    for &x in &[-0.5f32, -0.25, 0.0, 0.5] {
+        for &y in &[-0.5f32, 0.0, 0.5] {
+            rays.push(Ray::new(Vec3::new(x, y, -3.0), Vec3::Z));
+            rays.push(Ray::new(Vec3::new(-3.0, x, y), Vec3::X));
+            rays.push(Ray::new(Vec3::new(x, 3.0, y), -Vec3::Y));
+            rays.push(Ray::new(Vec3::new(x * 0.5, y * 0.5, 0.0), Vec3::new(x, y, 1.0).normalize()));
+        }
+    }
+    check_all("cube", &soup, &rays);
+}
+
+#[test]
+fn stanford_bunny() {
+    let path = kit::shared_scenes().join("bunny_4968.obj");
+    let soup = kit::read_obj_triangles(&path);
+    assert_eq!(soup.len(), 4968);
+    let b = soup.bounds();
+    let mut rng = Pcg32::new(10, 1);
+    let outer = Aabb::new(b.min - b.extent(), b.max + b.extent());
+    let rays = kit::random_rays(&mut rng, 2000, &outer, &b);
+    check_all("bunny", &soup, &rays);
+}

@@ -1,0 +1,169 @@
+//! Ray–primitive kernels shared by shapes, structures and tests.
+
+use glam::{DVec3, Vec3};
+
+use crate::Ray;
+
+/// Watertight ray–triangle intersection (Woop, Benthin & Wald, JCGT 2013).
+///
+/// The triangle is transformed into a ray-aligned space (shear so that the ray runs along
+/// +z from the origin) and hit by 2D edge functions. Edge functions that come out exactly
+/// zero are recomputed in double precision, so a ray through a shared edge or vertex hits
+/// at least one of the adjacent triangles: no ray slips through a closed mesh.
+///
+/// Returns `(t, b1, b2)`: the distance and the barycentric weights of `p1` and `p2`
+/// (the weight of `p0` is `1 - b1 - b2`), for `t` in `(ray.t_min, ray.t_max]`.
+#[inline]
+pub fn triangle(ray: &Ray, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<(f32, f32, f32)> {
+    let d = ray.dir;
+    let ad = d.abs();
+    let kz = if ad.x > ad.y { if ad.x > ad.z { 0 } else { 2 } } else if ad.y > ad.z { 1 } else { 2 };
+    let mut kx = (kz + 1) % 3;
+    let mut ky = (kx + 1) % 3;
+    if d[kz] < 0.0 {
+        std::mem::swap(&mut kx, &mut ky);
+    }
+    let sx = d[kx] / d[kz];
+    let sy = d[ky] / d[kz];
+    let sz = 1.0 / d[kz];
+    let a = p0 - ray.origin;
+    let b = p1 - ray.origin;
+    let c = p2 - ray.origin;
+    let ax = a[kx] - sx * a[kz];
+    let ay = a[ky] - sy * a[kz];
+    let bx = b[kx] - sx * b[kz];
+    let by = b[ky] - sy * b[kz];
+    let cx = c[kx] - sx * c[kz];
+    let cy = c[ky] - sy * c[kz];
+    let mut u = cx * by - cy * bx;
+    let mut v = ax * cy - ay * cx;
+    let mut w = bx * ay - by * ax;
+    if u == 0.0 || v == 0.0 || w == 0.0 {
+        let (ax, ay, bx, by, cx, cy) = (ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64);
+        u = (cx * by - cy * bx) as f32;
+        v = (ax * cy - ay * cx) as f32;
+        w = (bx * ay - by * ax) as f32;
+    }
+    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        return None;
+    }
+    let det = u + v + w;
+    if det == 0.0 {
+        return None;
+    }
+    let az = sz * a[kz];
+    let bz = sz * b[kz];
+    let cz = sz * c[kz];
+    let t_scaled = u * az + v * bz + w * cz;
+    let inv_det = 1.0 / det;
+    let t = t_scaled * inv_det;
+    if !(t > ray.t_min && t <= ray.t_max) {
+        return None;
+    }
+    Some((t, v * inv_det, w * inv_det))
+}
+
+/// Ray–sphere intersection, nearest root in `(ray.t_min, ray.t_max]`.
+///
+/// The discriminant is computed as `r² - |l|²` with `l` the offset from the centre to the
+/// ray's closest approach (Hearn & Baker; Haines et al., Ray Tracing Gems ch. 7), which stays
+/// accurate when the sphere is small and far away, unlike `b² - 4ac`.
+#[inline]
+pub fn sphere(ray: &Ray, center: Vec3, radius: f32) -> Option<f32> {
+    let oc = ray.origin - center;
+    let a = ray.dir.length_squared();
+    let half_b = oc.dot(ray.dir);
+    let l = oc - (half_b / a) * ray.dir;
+    let disc = a * (radius * radius - l.length_squared());
+    if disc < 0.0 {
+        return None;
+    }
+    // Numerically stable roots: q has the sign of -half_b, so no cancellation.
+    let q = -half_b - disc.sqrt().copysign(half_b);
+    let (mut t0, mut t1) = (q / a, if q != 0.0 { oc.length_squared().mul_add(1.0, -radius * radius) / q } else { q / a });
+    if t0 > t1 {
+        std::mem::swap(&mut t0, &mut t1);
+    }
+    if t0 > ray.t_min && t0 <= ray.t_max {
+        Some(t0)
+    } else if t1 > ray.t_min && t1 <= ray.t_max {
+        Some(t1)
+    } else {
+        None
+    }
+}
+
+/// Double-precision reference of [`triangle`]'s plane distance, for tests.
+pub fn triangle_plane_t(ray: &Ray, p0: Vec3, p1: Vec3, p2: Vec3) -> f64 {
+    let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
+    let (p0, p1, p2): (DVec3, DVec3, DVec3) = (p0.as_dvec3(), p1.as_dvec3(), p2.as_dvec3());
+    let n = (p1 - p0).cross(p2 - p0);
+    n.dot(p0 - o) / n.dot(d)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri() -> (Vec3, Vec3, Vec3) {
+        (Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0))
+    }
+
+    #[test]
+    fn triangle_interior_hit_hand_computed() {
+        let (a, b, c) = tri();
+        let r = Ray::new(Vec3::new(0.25, 0.5, 2.0), Vec3::new(0.0, 0.0, -1.0));
+        let (t, b1, b2) = triangle(&r, a, b, c).unwrap();
+        assert!((t - 2.0).abs() < 1e-6);
+        assert!((b1 - 0.25).abs() < 1e-6 && (b2 - 0.5).abs() < 1e-6);
+        // From behind: triangles are two-sided.
+        let r = Ray::new(Vec3::new(0.25, 0.5, -3.0), Vec3::new(0.0, 0.0, 1.0));
+        assert!((triangle(&r, a, b, c).unwrap().0 - 3.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn triangle_edges_and_vertices_are_hit() {
+        let (a, b, c) = tri();
+        for p in [Vec3::new(0.5, 0.0, 0.0), Vec3::new(0.0, 0.5, 0.0), Vec3::new(0.5, 0.5, 0.0), a, b, c] {
+            let r = Ray::new(p + Vec3::Z, -Vec3::Z);
+            let (t, ..) = triangle(&r, a, b, c).unwrap_or_else(|| panic!("missed {p}"));
+            assert!((t - 1.0).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn triangle_misses_and_interval() {
+        let (a, b, c) = tri();
+        let r = Ray::new(Vec3::new(0.6, 0.6, 1.0), -Vec3::Z);
+        assert!(triangle(&r, a, b, c).is_none());
+        let r = Ray::segment(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z, 0.0, 0.5);
+        assert!(triangle(&r, a, b, c).is_none());
+        // Degenerate (zero-area) triangle: never hit.
+        let r = Ray::new(Vec3::new(0.5, 0.0, 1.0), -Vec3::Z);
+        assert!(triangle(&r, a, b, b).is_none());
+        // Ray in the triangle's plane: no hit.
+        let r = Ray::new(Vec3::new(-1.0, 0.2, 0.0), Vec3::X);
+        assert!(triangle(&r, a, b, c).is_none());
+    }
+
+    #[test]
+    fn sphere_hand_computed() {
+        let r = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z);
+        assert!((sphere(&r, Vec3::ZERO, 1.0).unwrap() - 4.0).abs() < 1e-6);
+        // From inside: the far root.
+        let r = Ray::new(Vec3::ZERO, Vec3::Z);
+        assert!((sphere(&r, Vec3::ZERO, 2.0).unwrap() - 2.0).abs() < 1e-6);
+        // Tangent ray at distance exactly r: hits at t = 5.
+        let r = Ray::new(Vec3::new(1.0, 0.0, -5.0), Vec3::Z);
+        assert!((sphere(&r, Vec3::ZERO, 1.0).unwrap() - 5.0).abs() < 1e-3);
+        let r = Ray::new(Vec3::new(1.01, 0.0, -5.0), Vec3::Z);
+        assert!(sphere(&r, Vec3::ZERO, 1.0).is_none());
+        // Small sphere far away keeps its precision.
+        let r = Ray::new(Vec3::ZERO, Vec3::Z);
+        let t = sphere(&r, Vec3::new(0.0, 0.0, 1e4), 1e-2).unwrap();
+        assert!((t - (1e4 - 1e-2)).abs() < 1e-2 * 1e-2, "{t}");
+        // Non-normalised direction: t in units of dir.
+        let r = Ray::new(Vec3::new(0.0, 0.0, -5.0), 2.0 * Vec3::Z);
+        assert!((sphere(&r, Vec3::ZERO, 1.0).unwrap() - 2.0).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,24 @@
+//! Math and infrastructure shared by every raylab crate, built on `glam`.
+//!
+//! Nothing here knows about shapes, materials or files.
+
+pub mod bounds;
+pub mod color;
+pub mod frame;
+pub mod intersect;
+pub mod offset;
+pub mod ray;
+pub mod rng;
+pub mod sampling;
+pub mod transform;
+
+pub use bounds::{Aabb, BoundingSphere};
+pub use frame::Frame;
+pub use glam::{Vec2, Vec3};
+pub use offset::offset_ray_origin;
+pub use ray::Ray;
+pub use rng::Pcg32;
+pub use transform::Transform;
+
+/// Linear RGB radiance or reflectance, one `f32` per channel.
+pub type Rgb = Vec3;

@@ -1,0 +1,151 @@
+//! Fixtures for tests and benchmarks: seeded random geometry and rays, and a primitive
+//! soup (triangles and spheres) that implements [`Primitives`] with the same kernels the
+//! renderer uses.
+
+use std::ops::Range;
+use std::path::PathBuf;
+
+use raylab_accel::{PrimHit, Primitives};
+use raylab_core::{intersect, Aabb, Pcg32, Ray, Vec3};
+
+/// One primitive of a [`Soup`].
+#[derive(Clone, Copy, Debug)]
+pub enum Prim {
+    Triangle([Vec3; 3]),
+    Sphere { center: Vec3, radius: f32 },
+}
+
+/// A list of primitives, optionally grouped into objects (consecutive ranges).
+#[derive(Clone, Debug, Default)]
+pub struct Soup {
+    pub prims: Vec<Prim>,
+    pub objects: Vec<Range<u32>>,
+}
+
+impl Soup {
+    pub fn new(prims: Vec<Prim>) -> Self {
+        let n = prims.len() as u32;
+        Self { prims, objects: if n > 0 { vec![0..n] } else { vec![] } }
+    }
+
+    pub fn triangles(tris: impl IntoIterator<Item = [Vec3; 3]>) -> Self {
+        Self::new(tris.into_iter().map(Prim::Triangle).collect())
+    }
+
+    /// Appends another soup as a new object.
+    pub fn push_object(&mut self, other: Soup) {
+        let start = self.prims.len() as u32;
+        self.prims.extend(other.prims);
+        let end = self.prims.len() as u32;
+        if end > start {
+            self.objects.push(start..end);
+        }
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        raylab_accel::primitives::total_bounds(self)
+    }
+}
+
+impl Primitives for Soup {
+    fn len(&self) -> usize {
+        self.prims.len()
+    }
+
+    fn bounds(&self, i: u32) -> Aabb {
+        match self.prims[i as usize] {
+            Prim::Triangle(v) => Aabb::from_points(v),
+            Prim::Sphere { center, radius } => Aabb::new(center - Vec3::splat(radius), center + Vec3::splat(radius)),
+        }
+    }
+
+    fn intersect(&self, i: u32, ray: &Ray) -> Option<PrimHit> {
+        match self.prims[i as usize] {
+            Prim::Triangle([a, b, c]) => intersect::triangle(ray, a, b, c).map(|(t, u, v)| PrimHit { t, u, v }),
+            Prim::Sphere { center, radius } => intersect::sphere(ray, center, radius).map(|t| PrimHit { t, u: 0.0, v: 0.0 }),
+        }
+    }
+
+    fn objects(&self) -> Vec<Range<u32>> {
+        self.objects.clone()
+    }
+}
+
+pub fn random_point(rng: &mut Pcg32, b: &Aabb) -> Vec3 {
+    b.min + (b.max - b.min) * Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32())
+}
+
+pub fn random_dir(rng: &mut Pcg32) -> Vec3 {
+    raylab_core::sampling::uniform_sphere(rng.next_vec2())
+}
+
+/// `n` random triangles with vertices in `b`, each of size about `size` (a "soup").
+pub fn random_triangles(rng: &mut Pcg32, n: usize, b: &Aabb, size: f32) -> Soup {
+    Soup::triangles((0..n).map(|_| {
+        let c = random_point(rng, b);
+        [c + size * random_dir(rng), c + size * random_dir(rng), c + size * random_dir(rng)]
+    }))
+}
+
+pub fn random_spheres(rng: &mut Pcg32, n: usize, b: &Aabb, max_radius: f32) -> Soup {
+    Soup::new((0..n).map(|_| Prim::Sphere { center: random_point(rng, b), radius: max_radius * (0.05 + 0.95 * rng.next_f32()) }).collect())
+}
+
+/// Rays from random points of `from` towards random points of `to`, plus some with random
+/// directions; a quarter are axis-parallel.
+pub fn random_rays(rng: &mut Pcg32, n: usize, from: &Aabb, to: &Aabb) -> Vec<Ray> {
+    (0..n)
+        .map(|k| {
+            let o = random_point(rng, from);
+            let d = match k % 4 {
+                0 => random_dir(rng),
+                1 => {
+                    let axis = rng.below(3) as usize;
+                    let mut d = Vec3::ZERO;
+                    d[axis] = if rng.next_f32() < 0.5 { -1.0 } else { 1.0 };
+                    d
+                }
+                _ => (random_point(rng, to) - o).try_normalize().unwrap_or(Vec3::X),
+            };
+            Ray::new(o, d)
+        })
+        .collect()
+}
+
+/// A closed unit cube made of 12 triangles, centred at the origin (the seeds' cube).
+pub fn cube() -> Soup {
+    let v = |x: f32, y: f32, z: f32| Vec3::new(x, y, z) - Vec3::splat(0.5);
+    let c = [v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.), v(0., 1., 0.), v(0., 0., 1.), v(1., 0., 1.), v(1., 1., 1.), v(0., 1., 1.)];
+    let faces = [[0, 1, 2, 3], [5, 4, 7, 6], [4, 0, 3, 7], [1, 5, 6, 2], [3, 2, 6, 7], [4, 5, 1, 0]];
+    Soup::triangles(faces.iter().flat_map(|f| [[c[f[0]], c[f[1]], c[f[2]]], [c[f[0]], c[f[2]], c[f[3]]]]))
+}
+
+/// The folder of shared scenes (`../shared/scenes` beside the repository).
+pub fn shared_scenes() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes")
+}
+
+/// Reads the vertices and triangular faces of a plain OBJ file (tests only; the real
+/// loader lives in `raylab-loader`).
+pub fn read_obj_triangles(path: &std::path::Path) -> Soup {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut v = Vec::new();
+    let mut tris = Vec::new();
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let p: Vec<f32> = it.take(3).map(|s| s.parse().unwrap()).collect();
+                v.push(Vec3::new(p[0], p[1], p[2]));
+            }
+            Some("f") => {
+                let idx: Vec<usize> = it.map(|s| s.split('/').next().unwrap().parse::<usize>().unwrap() - 1).collect();
+                for k in 1..idx.len() - 1 {
+                    tris.push([v[idx[0]], v[idx[k]], v[idx[k + 1]]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    Soup::triangles(tris)
+}
