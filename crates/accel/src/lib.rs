@@ -8,9 +8,11 @@
 //!
 //! The runtime choice is [`AnyAccel`], a closed enum matched per call: no `dyn` in the hot loop.
 
+pub mod aabb;
 pub mod brute;
 pub mod bvh;
 pub mod counters;
+pub mod grid;
 pub mod primitives;
 pub mod stats;
 
@@ -18,11 +20,13 @@ use std::fmt;
 use std::str::FromStr;
 use std::time::Instant;
 
-use raylab_core::Ray;
+use raylab_core::{Aabb, Ray};
 
+pub use aabb::ObjectBoxes;
 pub use brute::Brute;
 pub use bvh::{Bvh, SplitMethod};
 pub use counters::Counters;
+pub use grid::Grid;
 pub use primitives::{Hit, PrimHit, Primitives};
 pub use stats::AccelStats;
 
@@ -64,10 +68,15 @@ pub enum AccelKind {
     BvhMedian,
     /// BVH split at the spatial midpoint of the longest axis.
     BvhMidpoint,
+    /// One bounding box per object (the first seed report's ray–mesh tests).
+    Aabb,
+    /// Uniform grid walked by 3D-DDA (Amanatides & Woo 1987).
+    Grid,
 }
 
 impl AccelKind {
-    pub const ALL: &'static [AccelKind] = &[AccelKind::None, AccelKind::Bvh, AccelKind::BvhMedian, AccelKind::BvhMidpoint];
+    pub const ALL: &'static [AccelKind] =
+        &[AccelKind::None, AccelKind::Bvh, AccelKind::BvhMedian, AccelKind::BvhMidpoint, AccelKind::Aabb, AccelKind::Grid];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -75,6 +84,8 @@ impl AccelKind {
             AccelKind::Bvh => "bvh",
             AccelKind::BvhMedian => "bvh-median",
             AccelKind::BvhMidpoint => "bvh-midpoint",
+            AccelKind::Aabb => "aabb",
+            AccelKind::Grid => "grid",
         }
     }
 
@@ -112,12 +123,32 @@ pub struct BuildOptions {
     pub max_leaf_size: usize,
     /// Number of bins of binned builders.
     pub bins: usize,
+    /// Grid cells per primitive, `λ` (the grid has about `λ·N` cells). pbrt-v1's `3∛N`
+    /// cells on the longest axis amounts to `λ = 27` on a cube; a handful is usual
+    /// (Wald et al. 2006; Ize et al. 2007, "Grid Creation Strategies").
+    pub grid_density: f32,
+    /// Grid cells per axis at most, so that a huge scene cannot exhaust memory.
+    pub grid_max_resolution: u32,
 }
 
 impl Default for BuildOptions {
     fn default() -> Self {
-        Self { traversal_cost: 1.0, intersection_cost: 1.0, max_leaf_size: 8, bins: 16 }
+        Self { traversal_cost: 1.0, intersection_cost: 1.0, max_leaf_size: 8, bins: 16, grid_density: 4.0, grid_max_resolution: 128 }
     }
+}
+
+/// Distance by which grids and kd-trees grow cells (or split planes) when they decide
+/// which side of a boundary a primitive or a ray is on: about 2⁻¹⁸ of the scene's largest
+/// coordinate, some thirty ulps. Rounding in a DDA step or a plane distance moves a point by
+/// a few ulps of the coordinates involved, so a primitive within the margin of a boundary is
+/// kept on both sides, and no hit is lost or taken from the wrong cell. Rays whose origin
+/// lies far outside the scene (beyond ~10⁴ scene sizes) are not covered by this bound.
+pub(crate) fn robust_margin(scene: &Aabb) -> f32 {
+    if scene.is_empty() {
+        return f32::MIN_POSITIVE;
+    }
+    let scale = scene.min.abs().max(scene.max.abs()).max_element().max(scene.extent().max_element());
+    (scale * (1.0 / 262_144.0)).max(f32::MIN_POSITIVE)
 }
 
 /// A built structure of any kind.
@@ -125,6 +156,8 @@ impl Default for BuildOptions {
 pub enum AnyAccel {
     None(Brute),
     Bvh(Bvh),
+    Aabb(ObjectBoxes),
+    Grid(Grid),
 }
 
 macro_rules! dispatch {
@@ -132,6 +165,8 @@ macro_rules! dispatch {
         match $self {
             AnyAccel::None($a) => $e,
             AnyAccel::Bvh($a) => $e,
+            AnyAccel::Aabb($a) => $e,
+            AnyAccel::Grid($a) => $e,
         }
     };
 }
@@ -145,6 +180,8 @@ impl AnyAccel {
             AccelKind::Bvh => AnyAccel::Bvh(Bvh::build(prims, SplitMethod::BinnedSah, opts)),
             AccelKind::BvhMedian => AnyAccel::Bvh(Bvh::build(prims, SplitMethod::Median, opts)),
             AccelKind::BvhMidpoint => AnyAccel::Bvh(Bvh::build(prims, SplitMethod::Midpoint, opts)),
+            AccelKind::Aabb => AnyAccel::Aabb(ObjectBoxes::build(prims)),
+            AccelKind::Grid => AnyAccel::Grid(Grid::build(prims, opts)),
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
         dispatch!(&mut accel, a => a.build_ms = ms);

@@ -17,6 +17,9 @@ pub struct AccelStats {
     /// SAH cost of the tree relative to its root box (traversal and intersection cost 1).
     pub sah_cost: f64,
     pub memory_bytes: usize,
+    /// Structure-specific figures in display order (a grid's resolution and cell counts, a
+    /// kd-tree's empty leaves, ...), as `(name, value)`.
+    pub notes: Vec<(String, String)>,
 }
 
 impl AccelStats {
@@ -30,6 +33,11 @@ impl AccelStats {
         self.leaves += 1;
         self.references += n;
     }
+
+    /// Appends a structure-specific figure to [`AccelStats::notes`].
+    pub fn note(&mut self, name: &str, value: impl fmt::Display) {
+        self.notes.push((name.to_string(), value.to_string()));
+    }
 }
 
 impl fmt::Display for AccelStats {
@@ -39,6 +47,9 @@ impl fmt::Display for AccelStats {
         let avg = if self.leaves > 0 { self.references as f64 / self.leaves as f64 } else { 0.0 };
         writeln!(f, "  references {} ({avg:.2} per leaf), SAH cost {:.2}", self.references, self.sah_cost)?;
         write!(f, "  memory {:.1} KiB", self.memory_bytes as f64 / 1024.0)?;
+        for (k, (name, value)) in self.notes.iter().enumerate() {
+            write!(f, "{}{name} {value}", if k == 0 { "\n  " } else { ", " })?;
+        }
         if !self.leaf_histogram.is_empty() {
             let last = self.leaf_histogram.iter().rposition(|&c| c > 0).unwrap_or(0);
             write!(f, "\n  leaf sizes:")?;
