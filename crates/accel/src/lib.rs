@@ -72,11 +72,15 @@ pub enum AccelKind {
     Aabb,
     /// Uniform grid walked by 3D-DDA (Amanatides & Woo 1987).
     Grid,
+    /// Linear BVH: Morton order, Karras 2012 hierarchy.
+    Lbvh,
+    /// BVH by parallel locally-ordered clustering (Meister & Bittner 2018).
+    LbvhPloc,
 }
 
 impl AccelKind {
     pub const ALL: &'static [AccelKind] =
-        &[AccelKind::None, AccelKind::Bvh, AccelKind::BvhMedian, AccelKind::BvhMidpoint, AccelKind::Aabb, AccelKind::Grid];
+        &[AccelKind::None, AccelKind::Bvh, AccelKind::BvhMedian, AccelKind::BvhMidpoint, AccelKind::Aabb, AccelKind::Grid, AccelKind::Lbvh, AccelKind::LbvhPloc];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -86,6 +90,8 @@ impl AccelKind {
             AccelKind::BvhMidpoint => "bvh-midpoint",
             AccelKind::Aabb => "aabb",
             AccelKind::Grid => "grid",
+            AccelKind::Lbvh => "lbvh",
+            AccelKind::LbvhPloc => "lbvh-ploc",
         }
     }
 
@@ -129,11 +135,14 @@ pub struct BuildOptions {
     pub grid_density: f32,
     /// Grid cells per axis at most, so that a huge scene cannot exhaust memory.
     pub grid_max_resolution: u32,
+    /// PLOC's search radius along the Morton curve (Meister & Bittner 2018 find 8-16 a
+    /// good trade between build time and tree quality).
+    pub ploc_radius: usize,
 }
 
 impl Default for BuildOptions {
     fn default() -> Self {
-        Self { traversal_cost: 1.0, intersection_cost: 1.0, max_leaf_size: 8, bins: 16, grid_density: 4.0, grid_max_resolution: 128 }
+        Self { traversal_cost: 1.0, intersection_cost: 1.0, max_leaf_size: 8, bins: 16, grid_density: 4.0, grid_max_resolution: 128, ploc_radius: 16 }
     }
 }
 
@@ -182,6 +191,8 @@ impl AnyAccel {
             AccelKind::BvhMidpoint => AnyAccel::Bvh(Bvh::build(prims, SplitMethod::Midpoint, opts)),
             AccelKind::Aabb => AnyAccel::Aabb(ObjectBoxes::build(prims)),
             AccelKind::Grid => AnyAccel::Grid(Grid::build(prims, opts)),
+            AccelKind::Lbvh => AnyAccel::Bvh(bvh::lbvh::build(prims, opts)),
+            AccelKind::LbvhPloc => AnyAccel::Bvh(bvh::ploc::build(prims, opts)),
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
         dispatch!(&mut accel, a => a.build_ms = ms);

@@ -1,11 +1,14 @@
 //! Bounding volume hierarchy: a binary tree of boxes, flattened into an array of 32-byte
 //! nodes with siblings adjacent (tinybvh's layout), traversed front to back.
 //!
-//! Builders (`build.rs`) differ only in where they split: binned SAH (Wald 2007), object
-//! median, spatial midpoint.
+//! Top-down builders (`build.rs`) differ only in where they split: binned SAH (Wald 2007),
+//! object median, spatial midpoint. Other builders produce the same nodes: `lbvh.rs`
+//! (Morton codes, Karras 2012) and `ploc.rs` (Meister & Bittner 2018).
 
 mod build;
+pub mod lbvh;
 mod node;
+pub mod ploc;
 mod sah;
 mod traverse;
 
