@@ -13,6 +13,7 @@ pub mod brute;
 pub mod bvh;
 pub mod counters;
 pub mod grid;
+pub mod kdtree;
 pub mod primitives;
 pub mod stats;
 
@@ -27,6 +28,7 @@ pub use brute::Brute;
 pub use bvh::{Bvh, SplitMethod};
 pub use counters::Counters;
 pub use grid::Grid;
+pub use kdtree::KdTree;
 pub use primitives::{Hit, PrimHit, Primitives};
 pub use stats::AccelStats;
 
@@ -76,11 +78,13 @@ pub enum AccelKind {
     Lbvh,
     /// BVH by parallel locally-ordered clustering (Meister & Bittner 2018).
     LbvhPloc,
+    /// SAH kd-tree with perfect splits, built in O(N log N) (Wald & Havran 2006).
+    KdTree,
 }
 
 impl AccelKind {
     pub const ALL: &'static [AccelKind] =
-        &[AccelKind::None, AccelKind::Bvh, AccelKind::BvhMedian, AccelKind::BvhMidpoint, AccelKind::Aabb, AccelKind::Grid, AccelKind::Lbvh, AccelKind::LbvhPloc];
+        &[AccelKind::None, AccelKind::Bvh, AccelKind::BvhMedian, AccelKind::BvhMidpoint, AccelKind::Aabb, AccelKind::Grid, AccelKind::Lbvh, AccelKind::LbvhPloc, AccelKind::KdTree];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -92,6 +96,7 @@ impl AccelKind {
             AccelKind::Grid => "grid",
             AccelKind::Lbvh => "lbvh",
             AccelKind::LbvhPloc => "lbvh-ploc",
+            AccelKind::KdTree => "kdtree",
         }
     }
 
@@ -138,11 +143,14 @@ pub struct BuildOptions {
     /// PLOC's search radius along the Morton curve (Meister & Bittner 2018 find 8-16 a
     /// good trade between build time and tree quality).
     pub ploc_radius: usize,
+    /// Fraction of the intersection cost a kd-tree split saves when one child is empty,
+    /// which favours cutting off empty space (Wald & Havran 2006 use 0.2, pbrt 0.5).
+    pub empty_bonus: f32,
 }
 
 impl Default for BuildOptions {
     fn default() -> Self {
-        Self { traversal_cost: 1.0, intersection_cost: 1.0, max_leaf_size: 8, bins: 16, grid_density: 4.0, grid_max_resolution: 128, ploc_radius: 16 }
+        Self { traversal_cost: 1.0, intersection_cost: 1.0, max_leaf_size: 8, bins: 16, grid_density: 4.0, grid_max_resolution: 128, ploc_radius: 16, empty_bonus: 0.2 }
     }
 }
 
@@ -167,6 +175,7 @@ pub enum AnyAccel {
     Bvh(Bvh),
     Aabb(ObjectBoxes),
     Grid(Grid),
+    KdTree(KdTree),
 }
 
 macro_rules! dispatch {
@@ -176,6 +185,7 @@ macro_rules! dispatch {
             AnyAccel::Bvh($a) => $e,
             AnyAccel::Aabb($a) => $e,
             AnyAccel::Grid($a) => $e,
+            AnyAccel::KdTree($a) => $e,
         }
     };
 }
@@ -193,6 +203,7 @@ impl AnyAccel {
             AccelKind::Grid => AnyAccel::Grid(Grid::build(prims, opts)),
             AccelKind::Lbvh => AnyAccel::Bvh(bvh::lbvh::build(prims, opts)),
             AccelKind::LbvhPloc => AnyAccel::Bvh(bvh::ploc::build(prims, opts)),
+            AccelKind::KdTree => AnyAccel::KdTree(KdTree::build(prims, opts)),
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
         dispatch!(&mut accel, a => a.build_ms = ms);

@@ -107,3 +107,35 @@ fn stanford_bunny() {
     let rays = kit::random_rays(&mut rng, 2000, &outer, &b);
     check_all("bunny", &soup, &rays);
 }
+
+/// Every structure does work on the bunny (non-zero counters of its kind), reports sane
+/// statistics, and a BVH tests far fewer primitives per ray than brute force.
+#[test]
+fn counters_and_stats_on_bunny() {
+    let soup = kit::read_obj_triangles(&kit::shared_scenes().join("bunny_4968.obj"));
+    let b = soup.bounds();
+    let mut rng = Pcg32::new(11, 1);
+    let rays = kit::random_rays(&mut rng, 500, &Aabb::new(b.min - b.extent(), b.max + b.extent()), &b);
+    let mut per_ray = Vec::new();
+    for &kind in AccelKind::ALL {
+        let accel = AnyAccel::build(kind, &soup, &BuildOptions::default());
+        let s = accel.stats();
+        println!("{s}");
+        assert_eq!(s.primitives, soup.len(), "{kind}");
+        assert!(s.references >= soup.len(), "{kind}: {} references", s.references);
+        assert!(s.memory_bytes > 0 || kind == AccelKind::None, "{kind}: no memory reported");
+        let mut c = Counters::default();
+        let hits = rays.iter().filter(|r| accel.intersect(&soup, r, &mut c).is_some()).count();
+        assert!(hits > 0, "{kind}: no ray hits the bunny");
+        assert_eq!(c.rays, rays.len() as u64, "{kind}");
+        assert!(c.prim_tests > 0, "{kind}: no primitive tests");
+        match kind {
+            AccelKind::None => {}
+            AccelKind::Aabb => assert!(c.object_tests > 0, "{kind}: no object tests"),
+            _ => assert!(c.nodes_visited > 0, "{kind}: no nodes visited"),
+        }
+        per_ray.push((kind, c.prim_tests as f64 / c.rays as f64));
+    }
+    let tests = |k: AccelKind| per_ray.iter().find(|(kind, _)| *kind == k).unwrap().1;
+    assert!(tests(AccelKind::Bvh) * 20.0 < tests(AccelKind::None), "{per_ray:?}");
+}
