@@ -15,6 +15,7 @@ pub mod counters;
 pub mod grid;
 pub mod kdtree;
 pub mod primitives;
+pub mod sphere_bvh;
 pub mod stats;
 
 use std::fmt;
@@ -30,6 +31,7 @@ pub use counters::Counters;
 pub use grid::Grid;
 pub use kdtree::KdTree;
 pub use primitives::{Hit, PrimHit, Primitives};
+pub use sphere_bvh::SphereBvh;
 pub use stats::AccelStats;
 
 /// What every acceleration structure offers.
@@ -80,11 +82,13 @@ pub enum AccelKind {
     LbvhPloc,
     /// SAH kd-tree with perfect splits, built in O(N log N) (Wald & Havran 2006).
     KdTree,
+    /// Bottom-up hierarchy of bounding spheres (the second seed report's BVH).
+    SphereBvh,
 }
 
 impl AccelKind {
     pub const ALL: &'static [AccelKind] =
-        &[AccelKind::None, AccelKind::Bvh, AccelKind::BvhMedian, AccelKind::BvhMidpoint, AccelKind::Aabb, AccelKind::Grid, AccelKind::Lbvh, AccelKind::LbvhPloc, AccelKind::KdTree];
+        &[AccelKind::None, AccelKind::Bvh, AccelKind::BvhMedian, AccelKind::BvhMidpoint, AccelKind::Aabb, AccelKind::Grid, AccelKind::Lbvh, AccelKind::LbvhPloc, AccelKind::KdTree, AccelKind::SphereBvh];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -97,6 +101,7 @@ impl AccelKind {
             AccelKind::Lbvh => "lbvh",
             AccelKind::LbvhPloc => "lbvh-ploc",
             AccelKind::KdTree => "kdtree",
+            AccelKind::SphereBvh => "sphere-bvh",
         }
     }
 
@@ -176,6 +181,7 @@ pub enum AnyAccel {
     Aabb(ObjectBoxes),
     Grid(Grid),
     KdTree(KdTree),
+    SphereBvh(SphereBvh),
 }
 
 macro_rules! dispatch {
@@ -186,6 +192,7 @@ macro_rules! dispatch {
             AnyAccel::Aabb($a) => $e,
             AnyAccel::Grid($a) => $e,
             AnyAccel::KdTree($a) => $e,
+            AnyAccel::SphereBvh($a) => $e,
         }
     };
 }
@@ -204,6 +211,7 @@ impl AnyAccel {
             AccelKind::Lbvh => AnyAccel::Bvh(bvh::lbvh::build(prims, opts)),
             AccelKind::LbvhPloc => AnyAccel::Bvh(bvh::ploc::build(prims, opts)),
             AccelKind::KdTree => AnyAccel::KdTree(KdTree::build(prims, opts)),
+            AccelKind::SphereBvh => AnyAccel::SphereBvh(SphereBvh::build(prims, opts)),
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
         dispatch!(&mut accel, a => a.build_ms = ms);

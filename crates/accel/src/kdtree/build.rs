@@ -83,11 +83,12 @@ pub(super) struct Split {
     pub planar_below: bool,
 }
 
-/// SAH cost of cutting `voxel` at `pos` with `n_below`, `n_above` primitives strictly on
-/// either side and `n_planar` lying in the plane (Wald & Havran 2006, §3): planar primitives
+/// SAH cost of cutting `voxel` at `pos` with `[below, planar, above]` primitives: wholly
+/// below, lying in the plane and wholly above (Wald & Havran 2006, §3): planar primitives
 /// go to the cheaper side. The intersection part is reduced by `empty_bonus` when a side
 /// is empty, which favours cutting off empty space (MacDonald & Booth 1990; pbrt).
-pub(super) fn split_cost(sah: &SahCost, empty_bonus: f32, voxel: &Aabb, axis: usize, pos: f32, n_below: usize, n_above: usize, n_planar: usize) -> (f32, bool) {
+pub(super) fn split_cost(sah: &SahCost, empty_bonus: f32, voxel: &Aabb, axis: usize, pos: f32, counts: [usize; 3]) -> (f32, bool) {
+    let [n_below, n_planar, n_above] = counts;
     let (below, above) = split_voxel(voxel, axis, pos);
     let area = voxel.half_area();
     let (pb, pa) = (below.half_area() / area, above.half_area() / area);
@@ -183,7 +184,7 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
             np[axis] = planar;
             na[axis] -= planar + ends;
             if pos > voxel.min[axis] && pos < voxel.max[axis] {
-                let (cost, planar_below) = split_cost(&self.sah, self.empty_bonus, voxel, axis, pos, nb[axis], na[axis], np[axis]);
+                let (cost, planar_below) = split_cost(&self.sah, self.empty_bonus, voxel, axis, pos, [nb[axis], np[axis], na[axis]]);
                 if best.is_none_or(|b| cost < b.cost) {
                     best = Some(Split { axis, pos, cost, planar_below });
                 }
@@ -273,12 +274,12 @@ mod tests {
         // planar below: 1 + (2/5)·3 + (4/5)·3 = 4.6; planar above: 1 + (2/5)·2 + (4/5)·4 = 5.0.
         let v = Aabb::new(Vec3::ZERO, Vec3::new(2.0, 1.0, 1.0));
         let sah = SahCost { traversal: 1.0, intersection: 1.0 };
-        let (cost, below) = split_cost(&sah, 0.2, &v, 0, 0.5, 2, 3, 1);
+        let (cost, below) = split_cost(&sah, 0.2, &v, 0, 0.5, [2, 1, 3]);
         assert!((cost - 4.6).abs() < 1e-5, "{cost}");
         assert!(below);
         // Cutting off empty space: 4 primitives above, none below, bonus 0.2:
         // 1 + 0.8·(4/5)·4 = 3.56, cheaper than the leaf's 4.
-        let (cost, _) = split_cost(&sah, 0.2, &v, 0, 0.5, 0, 4, 0);
+        let (cost, _) = split_cost(&sah, 0.2, &v, 0, 0.5, [0, 0, 4]);
         assert!((cost - 3.56).abs() < 1e-5, "{cost}");
     }
 
