@@ -3,13 +3,15 @@
 //!
 //! Top-down builders (`build.rs`) differ only in where they split: binned SAH (Wald 2007),
 //! object median, spatial midpoint. Other builders produce the same nodes: `lbvh.rs`
-//! (Morton codes, Karras 2012) and `ploc.rs` (Meister & Bittner 2018).
+//! (Morton codes, Karras 2012), `ploc.rs` (Meister & Bittner 2018) and `sbvh.rs` (spatial
+//! splits, Stich et al. 2009).
 
 mod build;
 pub mod lbvh;
 mod node;
 pub mod ploc;
 mod sah;
+pub mod sbvh;
 mod traverse;
 
 pub use node::BvhNode;
@@ -49,6 +51,9 @@ pub struct Bvh {
     pub name: &'static str,
     pub(crate) build_ms: f64,
     primitives: usize,
+    /// Leaves may hold clipped references (SBVH): a primitive may stick out of its leaf's
+    /// box, as long as the parts in all its leaves cover it.
+    spatial_splits: bool,
 }
 
 /// Trees deeper than this are cut into leaves: bounds the traversal stack.
@@ -57,13 +62,20 @@ pub(crate) const MAX_DEPTH: usize = 64;
 impl Bvh {
     pub fn build<P: Primitives + ?Sized>(prims: &P, method: SplitMethod, opts: &BuildOptions) -> Self {
         let (nodes, indices) = build::build(prims, method, opts);
-        Self { nodes, indices, name: method.accel_name(), build_ms: 0.0, primitives: prims.len() }
+        Self { nodes, indices, name: method.accel_name(), build_ms: 0.0, primitives: prims.len(), spatial_splits: false }
     }
 
     /// Wraps nodes made by another builder (LBVH, SBVH, ...) so that they share traversal,
     /// statistics and validation.
     pub fn from_parts(nodes: Vec<BvhNode>, indices: Vec<u32>, primitives: usize, name: &'static str) -> Self {
-        Self { nodes, indices, name, build_ms: 0.0, primitives }
+        Self { nodes, indices, name, build_ms: 0.0, primitives, spatial_splits: false }
+    }
+
+    /// Marks leaves as holding references clipped by spatial splits, which relaxes one check
+    /// of [`Bvh::validate`].
+    pub fn with_spatial_splits(mut self) -> Self {
+        self.spatial_splits = true;
+        self
     }
 
     pub fn root_bounds(&self) -> Aabb {
@@ -130,7 +142,14 @@ impl Bvh {
                         return err(format!("leaf {i} holds primitive {p} of {}", prims.len()));
                     }
                     seen[p as usize] += 1;
-                    if !b.contains_box(&prims.bounds(p)) {
+                    // With spatial splits a leaf bounds only the part of a primitive on its
+                    // side of the planes above it (Stich et al. 2009), so the primitive may
+                    // stick out; it must still touch the leaf. Without them it lies inside.
+                    let pb = prims.bounds(p);
+                    if self.spatial_splits && pb.intersection(b).is_empty() {
+                        return err(format!("primitive {p} does not touch leaf {i}"));
+                    }
+                    if !self.spatial_splits && !b.contains_box(&pb) {
                         return err(format!("primitive {p} sticks out of leaf {i}"));
                     }
                 }

@@ -1,0 +1,296 @@
+//! SBVH, the spatial-split BVH (Stich, Friedrich & Dietrich 2009, "Spatial Splits in
+//! Bounding Volume Hierarchies"). A node may be split like a kd-tree, by a plane that cuts
+//! primitives: a primitive straddling the plane is referenced from both children, each
+//! reference bounded by the primitive's part on its side (`Primitives::clipped_bounds`).
+//! Leaf boxes shrink around long, thin or diagonal triangles at the price of duplicate
+//! references.
+//!
+//! Each node compares the best binned object split (Wald 2007) with the best binned
+//! spatial split; spatial splits are only tried where the object split's children overlap
+//! by more than `α` times the root's area, which keeps duplication to where it pays.
+//! Straddling references may be "unsplit" (§4.3): sent whole to one child when that costs
+//! less than duplicating them.
+
+use raylab_core::Aabb;
+
+use super::{Bvh, BvhNode, SahCost, MAX_DEPTH};
+use crate::{robust_margin, BuildOptions, Primitives};
+
+/// Duplicate references allowed, as a fraction of the primitive count. Stich et al. bound
+/// duplication by `α` alone; a budget (as in Embree's spatial-split builder) also bounds
+/// memory on adversarial input. It is shared between children in proportion to their sizes,
+/// so the tree does not depend on the order nodes are built in.
+const SPLIT_BUDGET: f32 = 1.0;
+
+/// A reference to a primitive, bounded by the part of it inside this node.
+#[derive(Clone, Copy, Debug)]
+struct Ref {
+    bounds: Aabb,
+    prim: u32,
+}
+
+enum Split {
+    /// Refs whose centroid falls in a bin below `plane` go left.
+    Object { axis: usize, plane: usize, lo: f32, scale: f32 },
+    /// A plane at `pos`; `left`, `right`, `n_left`, `n_right` are the children estimated by
+    /// the bins, used to decide unsplitting.
+    Spatial { axis: usize, pos: f32, left: Aabb, right: Aabb, n_left: usize, n_right: usize },
+}
+
+struct Builder<'a, P: ?Sized> {
+    prims: &'a P,
+    sah: SahCost,
+    max_leaf: usize,
+    bins: usize,
+    /// `α` times the root's half area: below this overlap no spatial split is tried.
+    min_overlap: f32,
+    /// Leaf boxes are grown by this much (see [`super::lbvh::grown_bounds`]).
+    margin: f32,
+    nodes: Vec<BvhNode>,
+    indices: Vec<u32>,
+}
+
+pub fn build<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions) -> Bvh {
+    let n = prims.len();
+    let refs: Vec<Ref> = (0..n as u32).map(|i| Ref { bounds: prims.bounds(i), prim: i }).collect();
+    let root = refs.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds));
+    let mut b = Builder {
+        prims,
+        sah: SahCost::from_options(opts),
+        max_leaf: opts.max_leaf_size.max(1),
+        bins: opts.bins.clamp(2, 256),
+        min_overlap: opts.spatial_split_alpha * root.half_area(),
+        margin: robust_margin(&root),
+        nodes: Vec::new(),
+        indices: Vec::new(),
+    };
+    if n > 0 {
+        b.nodes.push(BvhNode::interior(Aabb::EMPTY, 0));
+        b.node(0, refs, 1, (SPLIT_BUDGET * n as f32) as usize);
+    }
+    Bvh::from_parts(b.nodes, b.indices, n, "sbvh").with_spatial_splits()
+}
+
+impl<P: Primitives + ?Sized> Builder<'_, P> {
+    /// Builds the subtree over `refs` into `nodes[slot]`, allowing `budget` more duplicate
+    /// references below; returns the box written.
+    fn node(&mut self, slot: usize, mut refs: Vec<Ref>, depth: usize, budget: usize) -> Aabb {
+        let bounds = refs.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds));
+        let n = refs.len();
+        let split = if n <= 1 || depth >= MAX_DEPTH { None } else { self.split(&refs, &bounds, budget) };
+        let children = match split.and_then(|s| self.apply(&refs, s, budget)) {
+            Some(c) => Some(c),
+            // No plane separates the references (all centroids coincide, or a spatial split
+            // left one side empty): halve by index while the leaf would be too large.
+            None if n > self.max_leaf && depth < MAX_DEPTH => {
+                let right = refs.split_off(n / 2);
+                Some((std::mem::take(&mut refs), right))
+            }
+            None => None,
+        };
+        let Some((left, right)) = children else {
+            let leaf = Aabb { min: bounds.min - self.margin, max: bounds.max + self.margin };
+            self.nodes[slot] = BvhNode::leaf(leaf, self.indices.len() as u32, n as u32);
+            self.indices.extend(refs.iter().map(|r| r.prim));
+            return leaf;
+        };
+        let dups = (left.len() + right.len()).saturating_sub(n);
+        let rest = budget.saturating_sub(dups);
+        let left_budget = rest * left.len() / (left.len() + right.len());
+        let l = self.nodes.len();
+        self.nodes.push(BvhNode::interior(Aabb::EMPTY, 0));
+        self.nodes.push(BvhNode::interior(Aabb::EMPTY, 0));
+        let bl = self.node(l, left, depth + 1, left_budget);
+        let br = self.node(l + 1, right, depth + 1, rest - left_budget);
+        let b = bl.union(br);
+        self.nodes[slot] = BvhNode::interior(b, l as u32);
+        b
+    }
+
+    /// The cheaper of the best object and spatial splits, or `None` when a leaf is cheaper
+    /// and allowed.
+    fn split(&self, refs: &[Ref], bounds: &Aabb, budget: usize) -> Option<Split> {
+        let object = self.object_split(refs, bounds);
+        let overlap = object.as_ref().map_or(f32::INFINITY, |(_, _, l, r)| l.intersection(*r).half_area());
+        let spatial = (budget > 0 && overlap > self.min_overlap).then(|| self.spatial_split(refs, bounds)).flatten();
+        let best = match (object, spatial) {
+            (Some((co, o, _, _)), Some((cs, s))) => Some(if cs < co { (cs, s) } else { (co, o) }),
+            (Some((co, o, _, _)), None) => Some((co, o)),
+            (None, s) => s,
+        };
+        let (cost, split) = best?;
+        (cost < self.sah.leaf(refs.len()) || refs.len() > self.max_leaf).then_some(split)
+    }
+
+    /// Binned SAH over reference centroids (Wald 2007): cost, split, and the two children's
+    /// boxes (for the overlap test).
+    fn object_split(&self, refs: &[Ref], bounds: &Aabb) -> Option<(f32, Split, Aabb, Aabb)> {
+        let nb = self.bins;
+        let cb = Aabb::from_points(refs.iter().map(|r| r.bounds.centroid()));
+        let mut best: Option<(f32, Split, Aabb, Aabb)> = None;
+        for axis in 0..3 {
+            let (lo, hi) = (cb.min[axis], cb.max[axis]);
+            if hi <= lo {
+                continue;
+            }
+            let scale = nb as f32 / (hi - lo);
+            let mut bin_bounds = vec![Aabb::EMPTY; nb];
+            let mut bin_count = vec![0usize; nb];
+            for r in refs {
+                let b = bin_of(r.bounds.centroid()[axis], lo, scale, nb);
+                bin_bounds[b] = bin_bounds[b].union(r.bounds);
+                bin_count[b] += 1;
+            }
+            let sweep = Sweep::new(&bin_bounds, &bin_count, &bin_count);
+            for p in 1..nb {
+                let (left, nl, right, nr) = sweep.at(p);
+                if nl == 0 || nr == 0 {
+                    continue;
+                }
+                let cost = self.sah.split(bounds, &left, nl, &right, nr);
+                if best.as_ref().is_none_or(|b| cost < b.0) {
+                    best = Some((cost, Split::Object { axis, plane: p, lo, scale }, left, right));
+                }
+            }
+        }
+        best
+    }
+
+    /// Binned spatial split (Stich et al. 2009, §4.2): bins are equal slabs of the node's
+    /// box; each reference is chopped into the bins it spans, counted as entering its first
+    /// bin and leaving its last, so a plane's left side counts entries and its right exits.
+    fn spatial_split(&self, refs: &[Ref], bounds: &Aabb) -> Option<(f32, Split)> {
+        let nb = self.bins;
+        let mut best: Option<(f32, Split)> = None;
+        for axis in 0..3 {
+            let (lo, hi) = (bounds.min[axis], bounds.max[axis]);
+            if hi <= lo {
+                continue;
+            }
+            let width = (hi - lo) / nb as f32;
+            let scale = nb as f32 / (hi - lo);
+            let plane = |k: usize| if k == nb { hi } else { lo + k as f32 * width };
+            let mut bin_bounds = vec![Aabb::EMPTY; nb];
+            let (mut enter, mut exit) = (vec![0usize; nb], vec![0usize; nb]);
+            for r in refs {
+                let first = bin_of(r.bounds.min[axis], lo, scale, nb);
+                let last = bin_of(r.bounds.max[axis], lo, scale, nb).max(first);
+                enter[first] += 1;
+                exit[last] += 1;
+                for (k, bin) in bin_bounds.iter_mut().enumerate().take(last + 1).skip(first) {
+                    let mut slab = r.bounds;
+                    slab.min[axis] = slab.min[axis].max(plane(k));
+                    slab.max[axis] = slab.max[axis].min(plane(k + 1));
+                    if let Some(part) = self.clip(r.prim, &slab) {
+                        *bin = bin.union(part);
+                    }
+                }
+            }
+            let sweep = Sweep::new(&bin_bounds, &enter, &exit);
+            for p in 1..nb {
+                let (left, nl, right, nr) = sweep.at(p);
+                if nl == 0 || nr == 0 {
+                    continue;
+                }
+                let cost = self.sah.split(bounds, &left, nl, &right, nr);
+                if best.as_ref().is_none_or(|b| cost < b.0) {
+                    best = Some((cost, Split::Spatial { axis, pos: plane(p), left, right, n_left: nl, n_right: nr }));
+                }
+            }
+        }
+        best
+    }
+
+    /// The part of primitive `prim` inside `clip`, or `None` when there is none.
+    fn clip(&self, prim: u32, clip: &Aabb) -> Option<Aabb> {
+        if clip.is_empty() {
+            return None;
+        }
+        let b = self.prims.clipped_bounds(prim, clip).intersection(*clip);
+        (!b.is_empty()).then_some(b)
+    }
+
+    /// Distributes `refs` between the children; `None` when one side would be empty.
+    fn apply(&self, refs: &[Ref], split: Split, budget: usize) -> Option<(Vec<Ref>, Vec<Ref>)> {
+        let (mut left, mut right) = (Vec::new(), Vec::new());
+        match split {
+            Split::Object { axis, plane, lo, scale } => {
+                for r in refs.iter() {
+                    let side = if bin_of(r.bounds.centroid()[axis], lo, scale, self.bins) < plane { &mut left } else { &mut right };
+                    side.push(*r);
+                }
+            }
+            Split::Spatial { axis, pos, left: lb, right: rb, n_left, n_right } => {
+                let mut dups = 0;
+                for r in refs.iter() {
+                    if r.bounds.max[axis] <= pos {
+                        left.push(*r);
+                        continue;
+                    }
+                    if r.bounds.min[axis] >= pos {
+                        right.push(*r);
+                        continue;
+                    }
+                    let (mut below, mut above) = (r.bounds, r.bounds);
+                    below.max[axis] = pos;
+                    above.min[axis] = pos;
+                    match (self.clip(r.prim, &below), self.clip(r.prim, &above)) {
+                        (Some(b), Some(a)) => {
+                            // Reference unsplitting (§4.3): keep the whole reference on one
+                            // side when that is cheaper than both halves, and always once
+                            // the duplication budget is spent.
+                            let (nl, nr) = (n_left as f32, n_right as f32);
+                            let split = lb.half_area() * nl + rb.half_area() * nr;
+                            let only_left = lb.union(r.bounds).half_area() * nl + rb.half_area() * (nr - 1.0);
+                            let only_right = lb.half_area() * (nl - 1.0) + rb.union(r.bounds).half_area() * nr;
+                            if dups < budget && split < only_left.min(only_right) {
+                                dups += 1;
+                                left.push(Ref { bounds: b, prim: r.prim });
+                                right.push(Ref { bounds: a, prim: r.prim });
+                            } else if only_left <= only_right {
+                                left.push(*r);
+                            } else {
+                                right.push(*r);
+                            }
+                        }
+                        (Some(b), None) => left.push(Ref { bounds: b, prim: r.prim }),
+                        (None, Some(a)) => right.push(Ref { bounds: a, prim: r.prim }),
+                        (None, None) => left.push(*r),
+                    }
+                }
+            }
+        }
+        (!left.is_empty() && !right.is_empty()).then_some((left, right))
+    }
+}
+
+/// Prefix and suffix sums over bins: the left side of plane `p` is bins `..p`, counted by
+/// `left_count`, the right side bins `p..`, counted by `right_count`.
+struct Sweep {
+    left: Vec<(Aabb, usize)>,
+    right: Vec<(Aabb, usize)>,
+}
+
+impl Sweep {
+    fn new(bins: &[Aabb], left_count: &[usize], right_count: &[usize]) -> Self {
+        let nb = bins.len();
+        let mut left = vec![(Aabb::EMPTY, 0); nb + 1];
+        let mut right = vec![(Aabb::EMPTY, 0); nb + 1];
+        for k in 0..nb {
+            left[k + 1] = (left[k].0.union(bins[k]), left[k].1 + left_count[k]);
+        }
+        for k in (0..nb).rev() {
+            right[k] = (right[k + 1].0.union(bins[k]), right[k + 1].1 + right_count[k]);
+        }
+        Self { left, right }
+    }
+
+    fn at(&self, p: usize) -> (Aabb, usize, Aabb, usize) {
+        (self.left[p].0, self.left[p].1, self.right[p].0, self.right[p].1)
+    }
+}
+
+#[inline]
+fn bin_of(x: f32, lo: f32, scale: f32, nb: usize) -> usize {
+    (((x - lo) * scale).max(0.0) as usize).min(nb - 1)
+}
