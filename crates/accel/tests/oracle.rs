@@ -1,6 +1,7 @@
 //! Every structure against the brute-force oracle, on the same seeded rays: the same
 //! primitive and distance for closest hits, the same answer for any-hit queries.
 
+use proptest::prelude::*;
 use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Primitives};
 use raylab_core::{Aabb, Pcg32, Ray, Vec3};
 use raylab_testkit::{self as kit, Prim, Soup};
@@ -138,4 +139,56 @@ fn counters_and_stats_on_bunny() {
     }
     let tests = |k: AccelKind| per_ray.iter().find(|(kind, _)| *kind == k).unwrap().1;
     assert!(tests(AccelKind::Bvh) * 20.0 < tests(AccelKind::None), "{per_ray:?}");
+}
+
+/// Long thin diagonal slivers: the case spatial splits exist for. The SBVH must duplicate
+/// some references, and every structure must still agree with the oracle.
+#[test]
+fn long_diagonal_slivers() {
+    let mut rng = Pcg32::new(12, 1);
+    let tris: Vec<[Vec3; 3]> = (0..300)
+        .map(|_| {
+            let a = kit::random_point(&mut rng, &unit());
+            let b = kit::random_point(&mut rng, &unit());
+            [a, b, b + 0.02 * kit::random_dir(&mut rng)]
+        })
+        .collect();
+    let soup = Soup::triangles(tris);
+    let rays = kit::random_rays(&mut rng, 1000, &unit(), &unit());
+    check_all("slivers", &soup, &rays);
+    let sbvh = AnyAccel::build(AccelKind::Sbvh, &soup, &BuildOptions::default()).stats();
+    assert!(sbvh.references > soup.len(), "no spatial split: {sbvh}");
+}
+
+/// A point of the lattice `{-2, -1.5, ..., 2}³`: vertices, edges and faces of lattice
+/// triangles lie exactly on the planes that grids, kd-trees and spatial splits cut at.
+fn lattice_point() -> impl Strategy<Value = Vec3> {
+    (-4i32..=4, -4i32..=4, -4i32..=4).prop_map(|(x, y, z)| Vec3::new(x as f32, y as f32, z as f32) * 0.5)
+}
+
+fn lattice_prim() -> impl Strategy<Value = Prim> {
+    prop_oneof![
+        4 => [lattice_point(), lattice_point(), lattice_point()].prop_map(Prim::Triangle),
+        1 => (lattice_point(), 1i32..=3).prop_map(|(center, r)| Prim::Sphere { center, radius: r as f32 * 0.25 }),
+    ]
+}
+
+/// Rays from lattice points (often inside boxes, on faces or at vertices) along lattice
+/// directions (axis-parallel, face and space diagonals), so they run through edges and
+/// vertices and along planes exactly.
+fn lattice_ray() -> impl Strategy<Value = Ray> {
+    (lattice_point(), -1i32..=1, -1i32..=1, -1i32..=1)
+        .prop_filter("direction must not be zero", |(_, x, y, z)| (*x, *y, *z) != (0, 0, 0))
+        .prop_map(|(o, x, y, z)| Ray::new(o, Vec3::new(x as f32, y as f32, z as f32)))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 512, ..ProptestConfig::default() })]
+
+    #[test]
+    fn lattice_soups(prims in prop::collection::vec(lattice_prim(), 1..24), rays in prop::collection::vec(lattice_ray(), 1..48)) {
+        let mut soup = Soup::new(prims[..prims.len() / 2].to_vec());
+        soup.push_object(Soup::new(prims[prims.len() / 2..].to_vec()));
+        check_all("lattice", &soup, &rays);
+    }
 }
