@@ -1,1 +1,54 @@
-fn main(){}
+//! The `raylab` command: a thin front end over the library crates. It parses arguments,
+//! reports progress and results, and decides exit codes; it renders nothing itself.
+
+mod commands;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(name = "raylab", version, about = "A CPU ray tracer and a laboratory of acceleration structures", long_about = "A CPU ray tracer and a laboratory of acceleration structures.\n\nWith no command, renders the embedded default scene to raylab.png.")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene file (or the embedded default scene) to an image
+    Render(commands::render::RenderArgs),
+    /// Print what a scene contains, without rendering
+    Inspect(commands::inspect::InspectArgs),
+    /// Compare acceleration structures side by side on the same rays
+    Bench(commands::bench::BenchArgs),
+    /// Trace a ray file through a scene or mesh
+    Trace(commands::trace::TraceArgs),
+    /// Write a procedural test scene of any size (Haines' Standard Procedural Databases)
+    Gen(commands::gen::GenArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => commands::render::run(&commands::render::RenderArgs::default()),
+        Some(Command::Render(a)) => commands::render::run(&a),
+        Some(Command::Inspect(a)) => commands::inspect::run(&a),
+        Some(Command::Gen(a)) => commands::gen::run(&a),
+        Some(Command::Bench(a)) => commands::bench::run(&a),
+        Some(Command::Trace(a)) => commands::trace::run(&a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("raylab: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Where an output image goes unless `-o` says otherwise.
+pub fn default_output() -> PathBuf {
+    PathBuf::from("raylab.png")
+}

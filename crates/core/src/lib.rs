@@ -15,7 +15,7 @@ pub mod transform;
 pub use bounds::{Aabb, BoundingSphere};
 pub use frame::Frame;
 pub use glam::{Vec2, Vec3};
-pub use offset::offset_ray_origin;
+pub use offset::{gamma, offset_ray_origin};
 pub use ray::Ray;
 pub use rng::Pcg32;
 pub use transform::Transform;

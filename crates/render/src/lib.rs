@@ -1,1 +1,23 @@
+//! The renderer: shapes, textures, materials, lights, camera, integrators and the render
+//! loop. It reads no files (that is `raylab-loader`'s job) and knows acceleration
+//! structures only through `raylab-accel`'s trait.
 
+pub mod camera;
+pub mod integrator;
+pub mod light;
+pub mod material;
+pub mod render;
+pub mod sampler;
+pub mod scene;
+pub mod shape;
+pub mod texture;
+
+pub use camera::Camera;
+pub use integrator::IntegratorKind;
+pub use light::Light;
+pub use material::{Material, MaterialId, TexColor, TextureId};
+pub use render::{render, RenderOutput};
+pub use sampler::SamplerKind;
+pub use scene::{Background, RenderSettings, Scene, SurfaceHit};
+pub use shape::{Geometry, Sphere, TriangleMesh};
+pub use texture::Texture;

@@ -1,0 +1,6 @@
+pub mod bench;
+pub mod gen;
+pub mod inspect;
+pub mod render;
+pub mod scene_args;
+pub mod trace;

@@ -1,0 +1,79 @@
+//! Options shared by the commands that load a scene.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Args;
+use raylab_accel::AccelKind;
+use raylab_loader::Overrides;
+use raylab_render::{IntegratorKind, SamplerKind, Scene};
+
+#[derive(Args, Clone, Debug, Default)]
+pub struct SceneArgs {
+    /// Scene file (TOML); the embedded default scene when omitted
+    pub scene: Option<PathBuf>,
+    /// Image width in pixels (overrides the scene's)
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub width: Option<u32>,
+    /// Image height in pixels (overrides the scene's)
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub height: Option<u32>,
+    /// Samples per pixel (a square number for the jittered sampler)
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1048576))]
+    pub spp: Option<u32>,
+    /// Pixel sampler: random or jittered
+    #[arg(long)]
+    pub sampler: Option<String>,
+    /// Maximum number of path segments from the camera
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub max_depth: Option<u32>,
+    /// Integrator: whitted or normals
+    #[arg(long)]
+    pub integrator: Option<String>,
+    /// Acceleration structure (none, bvh, ...; see `raylab inspect --help`)
+    #[arg(long)]
+    pub accel: Option<String>,
+    /// Seed of the per-pixel random streams
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Worker threads (default: all cores)
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+}
+
+impl SceneArgs {
+    pub fn overrides(&self) -> Result<Overrides> {
+        let parse_accel = |s: &String| s.parse::<AccelKind>().map_err(|e| anyhow::anyhow!("--accel: {e}"));
+        Ok(Overrides {
+            width: self.width,
+            height: self.height,
+            spp: self.spp,
+            max_depth: self.max_depth,
+            sampler: self.sampler.as_ref().map(|s| s.parse::<SamplerKind>().map_err(|e| anyhow::anyhow!("--sampler: {e}"))).transpose()?,
+            integrator: self.integrator.as_ref().map(|s| s.parse::<IntegratorKind>().map_err(|e| anyhow::anyhow!("--integrator: {e}"))).transpose()?,
+            accel: self.accel.as_ref().map(parse_accel).transpose()?,
+            seed: self.seed,
+        })
+    }
+
+    /// A thread pool of the requested size; scene loading, builds and rendering run in it.
+    pub fn pool(&self) -> Result<rayon::ThreadPool> {
+        let mut b = rayon::ThreadPoolBuilder::new();
+        if let Some(t) = self.threads {
+            b = b.num_threads(t as usize);
+        }
+        Ok(b.build()?)
+    }
+
+    pub fn scene_name(&self) -> String {
+        self.scene.as_ref().map_or("the default scene".into(), |p| p.display().to_string())
+    }
+
+    pub fn load(&self) -> Result<Scene> {
+        let o = self.overrides()?;
+        Ok(match &self.scene {
+            Some(p) => raylab_loader::load_scene(p, &o)?,
+            None => raylab_loader::default_scene(&o)?,
+        })
+    }
+}

@@ -1,0 +1,66 @@
+//! `raylab trace`: traces a ray file through a scene or mesh and prints the hit count, the
+//! sum of hit distances and Mrays/s, so that raylab can be compared with any other library
+//! on exactly the same rays.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Args;
+use raylab_accel::{AccelKind, AnyAccel, BuildOptions};
+use raylab_loader::Overrides;
+
+#[derive(Args, Clone, Debug)]
+pub struct TraceArgs {
+    /// Scene file (.toml) or bare mesh (.obj, .obj.gz)
+    pub scene: PathBuf,
+    /// Ray file: little-endian u64 count, then count × 8 f32 (ox oy oz tmin dx dy dz tmax)
+    #[arg(long)]
+    pub rays: PathBuf,
+    /// Acceleration structure
+    #[arg(long, default_value = "bvh")]
+    pub accel: String,
+    /// Any-hit (shadow) queries instead of closest hits
+    #[arg(long)]
+    pub any_hit: bool,
+    /// Worker threads (default: all cores)
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// Timed passes after one warm-up; the median is reported
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub repeats: u32,
+    /// Print JSON
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(a: &TraceArgs) -> Result<()> {
+    let kind: AccelKind = a.accel.parse().map_err(|e| anyhow::anyhow!("--accel: {e}"))?;
+    let rays = raylab_lab::rayfile::read(&a.rays)?;
+    let mut b = rayon::ThreadPoolBuilder::new();
+    if let Some(t) = a.threads {
+        b = b.num_threads(t as usize);
+    }
+    let pool = b.build()?;
+    pool.install(|| -> Result<()> {
+        let scene = raylab_loader::load_scene_or_mesh(&a.scene, &Overrides { accel: Some(AccelKind::None), ..Default::default() })?;
+        let accel = AnyAccel::build(kind, &scene.geometry, &BuildOptions::default());
+        let mut results = Vec::new();
+        for _ in 0..=a.repeats {
+            results.push(raylab_lab::trace(&accel, &scene.geometry, &rays, a.any_hit));
+        }
+        let mut secs: Vec<f64> = results[1..].iter().map(|r| r.seconds).collect();
+        secs.sort_by(f64::total_cmp);
+        let r = results[results.len() - 1];
+        let seconds = secs[secs.len() / 2];
+        let mrays = r.count as f64 / seconds.max(1e-12) / 1e6;
+        if a.json {
+            println!(
+                "{}",
+                serde_json::json!({ "rays": r.count, "hits": r.hits, "t_sum": r.t_sum, "seconds": seconds, "mrays_per_s": mrays, "accel": kind.name(), "any_hit": a.any_hit, "threads": rayon::current_num_threads() })
+            );
+        } else {
+            println!("rays {}  hits {}  t_sum {:.6}  {:.2} Mrays/s ({}, {}, median of {} on {} threads)", r.count, r.hits, r.t_sum, mrays, kind, if a.any_hit { "any hit" } else { "closest hit" }, a.repeats, rayon::current_num_threads());
+        }
+        Ok(())
+    })
+}

@@ -1,0 +1,11 @@
+//! The laboratory: ray sets generated once per scene and shared by every structure,
+//! measured tracing checked against an oracle, the binary ray-file format, and reports.
+
+pub mod bench;
+pub mod rayfile;
+pub mod report;
+pub mod rays;
+pub mod trace;
+
+pub use rays::{RayKind, RaySet};
+pub use trace::{trace, TraceResult};

@@ -1,0 +1,99 @@
+//! Ray sets: primary camera rays, diffuse bounces from their hits, shadow rays towards the
+//! lights. Generated once per scene (with a reference structure) and traced by every
+//! structure, so that all of them answer exactly the same queries.
+
+use std::fmt;
+use std::str::FromStr;
+
+use rayon::prelude::*;
+use raylab_accel::Counters;
+use raylab_core::{sampling, Frame, Pcg32, Ray, Vec2};
+use raylab_render::{Light, Scene};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum RayKind {
+    /// One camera ray through each pixel centre: coherent.
+    Primary,
+    /// A cosine-distributed bounce from each primary hit: incoherent.
+    Diffuse,
+    /// From each primary hit towards a light, stopping at it: any-hit queries.
+    Shadow,
+}
+
+impl RayKind {
+    pub const ALL: &'static [RayKind] = &[RayKind::Primary, RayKind::Diffuse, RayKind::Shadow];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            RayKind::Primary => "primary",
+            RayKind::Diffuse => "diffuse",
+            RayKind::Shadow => "shadow",
+        }
+    }
+
+    /// Shadow rays ask "is anything there?", the others "what is hit first?".
+    pub fn any_hit(self) -> bool {
+        self == RayKind::Shadow
+    }
+}
+
+impl fmt::Display for RayKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for RayKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL.iter().copied().find(|k| k.name() == s).ok_or_else(|| format!("unknown ray kind `{s}` (valid: primary, diffuse, shadow)"))
+    }
+}
+
+/// A named list of rays.
+#[derive(Clone, Debug)]
+pub struct RaySet {
+    pub kind: RayKind,
+    pub rays: Vec<Ray>,
+}
+
+/// Generates the requested ray sets for `scene` at `width × height` camera rays, using the
+/// scene's own structure to find the primary hits. Deterministic for a given `seed`.
+pub fn generate(scene: &Scene, width: u32, height: u32, kinds: &[RayKind], seed: u64) -> Vec<RaySet> {
+    let primary: Vec<Ray> = (0..height)
+        .flat_map(|y| (0..width).map(move |x| (x, y)))
+        .map(|(x, y)| scene.camera.ray(Vec2::new((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32), Vec2::splat(0.5)))
+        .collect();
+    let lights: Vec<&Light> = scene.lights.iter().filter(|l| !matches!(l, Light::Ambient { .. })).collect();
+    let secondary: Vec<(Option<Ray>, Option<Ray>)> = primary
+        .par_iter()
+        .enumerate()
+        .map(|(i, ray)| {
+            let mut c = Counters::default();
+            let Some(hit) = scene.intersect(ray, &mut c) else { return (None, None) };
+            let mut rng = Pcg32::new(seed, i as u64);
+            let wo = -ray.dir;
+            let n = if hit.geom.ng.dot(wo) < 0.0 { -hit.geom.ng } else { hit.geom.ng };
+            let d = Frame::from_z(n).to_world(sampling::cosine_hemisphere(rng.next_vec2()));
+            let diffuse = hit.spawn(d);
+            let shadow = if lights.is_empty() {
+                None
+            } else {
+                let light = lights[rng.below(lights.len() as u32) as usize];
+                light.sample(hit.geom.p).map(|s| hit.spawn_to(s.wi, s.dist.min(1e30)))
+            };
+            (Some(diffuse), shadow)
+        })
+        .collect();
+    kinds
+        .iter()
+        .map(|&kind| RaySet {
+            kind,
+            rays: match kind {
+                RayKind::Primary => primary.clone(),
+                RayKind::Diffuse => secondary.iter().filter_map(|s| s.0).collect(),
+                RayKind::Shadow => secondary.iter().filter_map(|s| s.1).collect(),
+            },
+        })
+        .collect()
+}

@@ -1,0 +1,363 @@
+//! Reading textures and writing rendered images: PNG/JPEG (8-bit sRGB, via `image`),
+//! OpenEXR (linear half/float, via `exr`), PFM (linear float) and PPM (binary P6, the
+//! seeds' output format). Every error starts with the path.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+use raylab_core::color::{linear_to_srgb8, srgb_to_linear};
+use raylab_core::Rgb;
+
+/// Formats `write_image` can produce, for messages.
+pub fn image_format_names() -> &'static str {
+    "png, ppm, exr, pfm"
+}
+
+/// An image that could not be read or written.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {message}", path.display())]
+pub struct ImageError {
+    pub path: PathBuf,
+    pub message: String,
+}
+
+fn err(path: &Path, message: impl Into<String>) -> ImageError {
+    ImageError { path: path.to_path_buf(), message: message.into() }
+}
+
+/// How linear radiance becomes a displayable value in [0, 1] before sRGB encoding.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tonemap {
+    /// Clip at 1 (the classic ray tracer's behaviour).
+    Clamp,
+    /// `c / (1 + c)` per channel (Reinhard et al. 2002, simple form).
+    Reinhard,
+    /// Narkowicz's fit of the ACES filmic curve.
+    Aces,
+}
+
+impl Tonemap {
+    pub const ALL: [Tonemap; 3] = [Tonemap::Clamp, Tonemap::Reinhard, Tonemap::Aces];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Tonemap::Clamp => "clamp",
+            Tonemap::Reinhard => "reinhard",
+            Tonemap::Aces => "aces",
+        }
+    }
+
+    /// Maps one linear channel, scaled by `2^exposure`, into [0, 1]. Non-finite values give 0.
+    pub fn apply(self, v: f32, exposure: f32) -> f32 {
+        let v = v * exposure.exp2();
+        if !v.is_finite() || v <= 0.0 {
+            return 0.0;
+        }
+        match self {
+            Tonemap::Clamp => v.min(1.0),
+            Tonemap::Reinhard => v / (1.0 + v),
+            Tonemap::Aces => ((v * (2.51 * v + 0.03)) / (v * (2.43 * v + 0.59) + 0.14)).clamp(0.0, 1.0),
+        }
+    }
+}
+
+/// An unknown tone-map name.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UnknownTonemap(pub String);
+
+impl fmt::Display for UnknownTonemap {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let names: Vec<_> = Tonemap::ALL.iter().map(|t| t.name()).collect();
+        write!(f, "unknown tone map `{}` (valid: {})", self.0, names.join(", "))
+    }
+}
+
+impl std::error::Error for UnknownTonemap {}
+
+impl FromStr for Tonemap {
+    type Err = UnknownTonemap;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Tonemap::ALL.into_iter().find(|t| t.name() == s).ok_or_else(|| UnknownTonemap(s.to_string()))
+    }
+}
+
+fn extension(path: &Path) -> String {
+    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
+}
+
+/// Reads an image as linear RGB, top row first. 8-bit formats are decoded from sRGB when
+/// `srgb` is true (colour maps), taken as linear otherwise (normal maps, masks).
+pub fn read_image(path: &Path, srgb: bool) -> Result<(u32, u32, Vec<Rgb>), ImageError> {
+    let bytes = std::fs::read(path).map_err(|e| err(path, format!("cannot read: {e}")))?;
+    decode_image(path, &bytes, srgb)
+}
+
+/// Decodes image bytes; `path` names the format (by extension) and the messages.
+pub fn decode_image(path: &Path, bytes: &[u8], srgb: bool) -> Result<(u32, u32, Vec<Rgb>), ImageError> {
+    let (w, h, pixels) = match extension(path).as_str() {
+        "exr" => read_exr(path, bytes)?,
+        "pfm" => read_pfm(path, bytes)?,
+        "ppm" => read_ppm(path, bytes, srgb)?,
+        _ => read_8bit(path, bytes, srgb)?,
+    };
+    if w == 0 || h == 0 {
+        return Err(err(path, "image has no pixels"));
+    }
+    if let Some(i) = pixels.iter().position(|p| !p.is_finite()) {
+        return Err(err(path, format!("pixel ({}, {}) is not a finite number", i as u32 % w, i as u32 / w)));
+    }
+    Ok((w, h, pixels))
+}
+
+fn read_8bit(path: &Path, bytes: &[u8], srgb: bool) -> Result<(u32, u32, Vec<Rgb>), ImageError> {
+    let img = image::load_from_memory(bytes).map_err(|e| err(path, format!("cannot decode image: {e}")))?;
+    let rgb = img.to_rgb32f();
+    let decode = |v: f32| if srgb { srgb_to_linear(v) } else { v };
+    let pixels = rgb.pixels().map(|p| Rgb::new(decode(p[0]), decode(p[1]), decode(p[2]))).collect();
+    Ok((rgb.width(), rgb.height(), pixels))
+}
+
+fn read_exr(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Vec<Rgb>), ImageError> {
+    use exr::prelude::*;
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |res, _| (res.width(), vec![Rgb::ZERO; res.width() * res.height()]),
+            |(w, px): &mut (usize, Vec<Rgb>), pos, (r, g, b, _a): (f32, f32, f32, f32)| px[pos.y() * *w + pos.x()] = Rgb::new(r, g, b),
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(std::io::Cursor::new(bytes))
+        .map_err(|e| err(path, format!("cannot decode OpenEXR: {e}")))?;
+    let size = image.layer_data.size;
+    let (_, pixels) = image.layer_data.channel_data.pixels;
+    Ok((size.width() as u32, size.height() as u32, pixels))
+}
+
+/// Splits the whitespace-separated header tokens of a PPM/PFM (with `#` comments), returning
+/// the tokens and the offset of the binary data (after one whitespace byte).
+fn netpbm_header(path: &Path, bytes: &[u8], count: usize) -> Result<(Vec<String>, usize), ImageError> {
+    let mut tokens = Vec::new();
+    let mut i = 0;
+    while tokens.len() < count {
+        while i < bytes.len() && bytes[i].is_ascii_whitespace() {
+            i += 1;
+        }
+        if i < bytes.len() && bytes[i] == b'#' {
+            while i < bytes.len() && bytes[i] != b'\n' {
+                i += 1;
+            }
+            continue;
+        }
+        let start = i;
+        while i < bytes.len() && !bytes[i].is_ascii_whitespace() {
+            i += 1;
+        }
+        if start == i {
+            return Err(err(path, "truncated header"));
+        }
+        tokens.push(String::from_utf8_lossy(&bytes[start..i]).into_owned());
+    }
+    Ok((tokens, i + 1))
+}
+
+fn header_number<T: FromStr>(path: &Path, token: &str, what: &str) -> Result<T, ImageError> {
+    token.parse().map_err(|_| err(path, format!("header: {what} `{token}` is not a valid number")))
+}
+
+fn dimensions(path: &Path, tokens: &[String]) -> Result<(u32, u32), ImageError> {
+    let w: u32 = header_number(path, &tokens[1], "width")?;
+    let h: u32 = header_number(path, &tokens[2], "height")?;
+    if w == 0 || h == 0 || w > 1 << 16 || h > 1 << 16 {
+        return Err(err(path, format!("header: size {w}x{h} out of range (1..=65536)")));
+    }
+    Ok((w, h))
+}
+
+fn read_pfm(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Vec<Rgb>), ImageError> {
+    let (tokens, data) = netpbm_header(path, bytes, 4)?;
+    let channels = match tokens[0].as_str() {
+        "PF" => 3,
+        "Pf" => 1,
+        other => return Err(err(path, format!("not a PFM file (magic `{other}`, expected PF or Pf)"))),
+    };
+    let (w, h) = dimensions(path, &tokens)?;
+    let scale: f32 = header_number(path, &tokens[3], "scale")?;
+    let little = scale < 0.0;
+    let n = w as usize * h as usize * channels;
+    let body = bytes.get(data..data + n * 4).ok_or_else(|| err(path, format!("truncated: expected {} bytes of pixels", n * 4)))?;
+    let value = |k: usize| {
+        let b = [body[4 * k], body[4 * k + 1], body[4 * k + 2], body[4 * k + 3]];
+        if little { f32::from_le_bytes(b) } else { f32::from_be_bytes(b) }
+    };
+    let mut pixels = vec![Rgb::ZERO; w as usize * h as usize];
+    // PFM stores the bottom row first.
+    for y in 0..h as usize {
+        for x in 0..w as usize {
+            let k = ((h as usize - 1 - y) * w as usize + x) * channels;
+            pixels[y * w as usize + x] = if channels == 3 { Rgb::new(value(k), value(k + 1), value(k + 2)) } else { Rgb::splat(value(k)) };
+        }
+    }
+    Ok((w, h, pixels))
+}
+
+fn read_ppm(path: &Path, bytes: &[u8], srgb: bool) -> Result<(u32, u32, Vec<Rgb>), ImageError> {
+    let (tokens, data) = netpbm_header(path, bytes, 4)?;
+    if tokens[0] != "P6" {
+        return Err(err(path, format!("not a binary PPM file (magic `{}`, expected P6)", tokens[0])));
+    }
+    let (w, h) = dimensions(path, &tokens)?;
+    let max: u32 = header_number(path, &tokens[3], "maxval")?;
+    if max == 0 || max > 65535 {
+        return Err(err(path, format!("header: maxval {max} out of range (1..=65535)")));
+    }
+    let wide = max > 255;
+    let n = w as usize * h as usize * 3;
+    let size = if wide { 2 * n } else { n };
+    let body = bytes.get(data..data + size).ok_or_else(|| err(path, format!("truncated: expected {size} bytes of pixels")))?;
+    let sample = |k: usize| {
+        let v = if wide { u16::from_be_bytes([body[2 * k], body[2 * k + 1]]) as f32 } else { body[k] as f32 };
+        let v = v / max as f32;
+        if srgb { srgb_to_linear(v) } else { v }
+    };
+    let pixels = (0..w as usize * h as usize).map(|i| Rgb::new(sample(3 * i), sample(3 * i + 1), sample(3 * i + 2))).collect();
+    Ok((w, h, pixels))
+}
+
+/// 8-bit sRGB bytes (RGB interleaved) after exposure and tone map.
+fn to_srgb8(pixels: &[Rgb], tonemap: Tonemap, exposure: f32) -> Vec<u8> {
+    pixels.iter().flat_map(|p| [p.x, p.y, p.z]).map(|v| linear_to_srgb8(tonemap.apply(v, exposure))).collect()
+}
+
+/// Encodes an image as PNG bytes (8-bit sRGB).
+pub fn encode_png(width: u32, height: u32, pixels: &[Rgb], tonemap: Tonemap, exposure: f32) -> Result<Vec<u8>, ImageError> {
+    let path = Path::new("<png>");
+    let mut out = Vec::new();
+    let encoder = image::codecs::png::PngEncoder::new(&mut out);
+    image::ImageEncoder::write_image(encoder, &to_srgb8(pixels, tonemap, exposure), width, height, image::ExtendedColorType::Rgb8)
+        .map_err(|e| err(path, format!("cannot encode PNG: {e}")))?;
+    Ok(out)
+}
+
+/// Writes an image; the extension picks the format. PNG and PPM get exposure, tone map and
+/// sRGB encoding; EXR and PFM keep linear radiance (exposure still scales it).
+pub fn write_image(path: &Path, width: u32, height: u32, pixels: &[Rgb], tonemap: Tonemap, exposure: f32) -> Result<(), ImageError> {
+    assert_eq!(pixels.len(), width as usize * height as usize, "pixel count must match the size");
+    let bytes = match extension(path).as_str() {
+        "png" => encode_png(width, height, pixels, tonemap, exposure).map_err(|e| err(path, e.message))?,
+        "ppm" => {
+            let mut out = format!("P6\n{width} {height}\n255\n").into_bytes();
+            out.extend(to_srgb8(pixels, tonemap, exposure));
+            out
+        }
+        "pfm" => {
+            let mut out = format!("PF\n{width} {height}\n-1.0\n").into_bytes();
+            let scale = exposure.exp2();
+            for row in pixels.chunks(width as usize).rev() {
+                for p in row {
+                    for v in [p.x, p.y, p.z] {
+                        out.extend((finite_or_zero(v) * scale).to_le_bytes());
+                    }
+                }
+            }
+            out
+        }
+        "exr" => return write_exr(path, width, height, pixels, exposure),
+        other => return Err(err(path, format!("unknown image format `.{other}` (valid: {})", image_format_names()))),
+    };
+    std::fs::write(path, bytes).map_err(|e| err(path, format!("cannot write: {e}")))
+}
+
+fn finite_or_zero(v: f32) -> f32 {
+    if v.is_finite() { v } else { 0.0 }
+}
+
+fn write_exr(path: &Path, width: u32, height: u32, pixels: &[Rgb], exposure: f32) -> Result<(), ImageError> {
+    let scale = exposure.exp2();
+    exr::prelude::write_rgb_file(path, width as usize, height as usize, |x, y| {
+        let p = pixels[y * width as usize + x];
+        (finite_or_zero(p.x) * scale, finite_or_zero(p.y) * scale, finite_or_zero(p.z) * scale)
+    })
+    .map_err(|e| err(path, format!("cannot write OpenEXR: {e}")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gradient(w: u32, h: u32) -> Vec<Rgb> {
+        (0..w * h).map(|i| Rgb::new((i % w) as f32 / w as f32, (i / w) as f32 / h as f32, 0.25 + i as f32 * 0.01)).collect()
+    }
+
+    #[test]
+    fn float_formats_round_trip_exactly() {
+        let dir = std::env::temp_dir().join(format!("raylab-image-io-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let pixels = gradient(7, 5);
+        for ext in ["pfm", "exr"] {
+            let path = dir.join(format!("t.{ext}"));
+            write_image(&path, 7, 5, &pixels, Tonemap::Clamp, 0.0).unwrap();
+            let (w, h, back) = read_image(&path, false).unwrap();
+            assert_eq!((w, h), (7, 5));
+            assert_eq!(back, pixels, "{ext}");
+        }
+    }
+
+    #[test]
+    fn eight_bit_formats_round_trip_to_one_code() {
+        let dir = std::env::temp_dir().join(format!("raylab-image-io8-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let pixels: Vec<Rgb> = gradient(6, 4).into_iter().map(|p| p.min(Rgb::ONE)).collect();
+        for ext in ["png", "ppm"] {
+            let path = dir.join(format!("t.{ext}"));
+            write_image(&path, 6, 4, &pixels, Tonemap::Clamp, 0.0).unwrap();
+            let (w, h, back) = read_image(&path, true).unwrap();
+            assert_eq!((w, h), (6, 4));
+            for (a, b) in pixels.iter().zip(&back) {
+                assert!((*a - *b).abs().max_element() < 0.01, "{ext}: {a} vs {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn ppm_header_is_the_seeds_p6() {
+        let dir = std::env::temp_dir().join(format!("raylab-image-ppm-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("t.ppm");
+        write_image(&path, 2, 1, &[Rgb::ONE, Rgb::ZERO], Tonemap::Clamp, 0.0).unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"P6\n2 1\n255\n\xff\xff\xff\x00\x00\x00");
+    }
+
+    #[test]
+    fn errors_name_the_file() {
+        let e = write_image(Path::new("out.bmp"), 1, 1, &[Rgb::ONE], Tonemap::Clamp, 0.0).unwrap_err();
+        assert_eq!(e.to_string(), "out.bmp: unknown image format `.bmp` (valid: png, ppm, exr, pfm)");
+        let e = decode_image(Path::new("x.pfm"), b"PF\n2 2\n-1\n\0\0", false).unwrap_err();
+        assert_eq!(e.to_string(), "x.pfm: truncated: expected 48 bytes of pixels");
+        let e = decode_image(Path::new("x.ppm"), b"P3\n1 1\n255\n", false).unwrap_err();
+        assert_eq!(e.to_string(), "x.ppm: not a binary PPM file (magic `P3`, expected P6)");
+        let e = decode_image(Path::new("x.png"), b"garbage", false).unwrap_err();
+        assert!(e.to_string().starts_with("x.png: cannot decode image: "), "{e}");
+        let nan = [b"PF\n1 1\n-1\n".as_slice(), &f32::NAN.to_le_bytes().repeat(3)].concat();
+        let e = decode_image(Path::new("x.pfm"), &nan, false).unwrap_err();
+        assert_eq!(e.to_string(), "x.pfm: pixel (0, 0) is not a finite number");
+    }
+
+    #[test]
+    fn tonemaps_are_monotone_and_bounded() {
+        for t in Tonemap::ALL {
+            assert_eq!(t.name().parse::<Tonemap>().unwrap(), t);
+            let mut last = 0.0;
+            for i in 0..1000 {
+                let v = t.apply(i as f32 * 0.05, 0.0);
+                assert!((0.0..=1.0).contains(&v) && v >= last, "{t:?}");
+                last = v;
+            }
+            assert_eq!(t.apply(f32::NAN, 0.0), 0.0);
+        }
+        assert_eq!(Tonemap::Clamp.apply(0.25, 1.0), 0.5);
+        assert_eq!("gamma".parse::<Tonemap>().unwrap_err().to_string(), "unknown tone map `gamma` (valid: clamp, reinhard, aces)");
+    }
+}

@@ -1,0 +1,526 @@
+//! Scene files (TOML) to [`Scene`]s. The format is documented in `docs/scene-format.md`.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use raylab_accel::{AccelKind, BuildOptions};
+use raylab_core::{Rgb, Transform, Vec2, Vec3};
+use raylab_render::material::TexColor;
+use raylab_render::shape::Sphere;
+use raylab_render::texture::{Checker, CheckerSpace, Filter, ImageTexture, Noise, NoiseKind, Wrap};
+use raylab_render::{Background, Camera, IntegratorKind, Light, Material, MaterialId, RenderSettings, SamplerKind, Scene, Texture, TriangleMesh};
+
+use crate::error::LoadError;
+use crate::files::{not_found_message, Found, Resolver};
+use crate::obj::{load_obj, mtl_color, MtlMaterial};
+use crate::toml_read::{Doc, Table, Val};
+
+/// Values from the command line that replace the scene's before anything is built.
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+    pub spp: Option<u32>,
+    pub max_depth: Option<u32>,
+    pub sampler: Option<SamplerKind>,
+    pub integrator: Option<IntegratorKind>,
+    pub accel: Option<AccelKind>,
+    pub seed: Option<u64>,
+}
+
+const TOP: &[&str] = &["camera", "render", "background", "textures", "materials", "shapes", "lights"];
+const CAMERA: &[&str] = &["from", "at", "up", "vfov", "width", "height", "aperture", "focus_distance"];
+const RENDER: &[&str] = &["spp", "sampler", "max_depth", "integrator", "accel", "seed"];
+const BACKGROUND: &[&str] = &["color", "texture"];
+const TEXTURE: &[&str] = &["name", "type", "file", "wrap", "filter", "srgb", "scale", "even", "odd", "space", "kind", "colors", "octaves", "seed", "color"];
+const MATERIAL: &[&str] = &["name", "type", "albedo", "ka", "kd", "ks", "exponent", "reflectance", "ior"];
+const SHAPE: &[&str] = &["type", "material", "transform", "center", "radius", "vertices", "normals", "uvs", "file", "smooth"];
+const LIGHT: &[&str] = &["type", "position", "intensity", "direction", "irradiance"];
+const TRANSFORM_STEP: &[&str] = &["scale", "rotate", "translate"];
+const ROTATE: &[&str] = &["axis", "degrees"];
+
+/// Reads a scene file and everything it names, and builds its acceleration structure.
+pub fn load_scene(path: &Path, overrides: &Overrides) -> Result<Scene, LoadError> {
+    let src = crate::error::read_text(path)?;
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    load_scene_str(&src, path, &Resolver::Disk { base }, overrides)
+}
+
+/// Parses scene text; `path` names it in messages, `resolver` finds the files it names.
+pub fn load_scene_str(src: &str, path: &Path, resolver: &Resolver, overrides: &Overrides) -> Result<Scene, LoadError> {
+    let doc = Doc::new(path, src);
+    let root = doc.parse(src)?;
+    let top = Table::new(&doc, String::new(), root.span(), root.get_ref(), TOP)?;
+    let mut b = Builder { doc: &doc, resolver, texture_ids: HashMap::new(), material_ids: HashMap::new(), mtl_cache: HashMap::new() };
+
+    let settings = b.settings(&top, overrides)?;
+    let camera = b.camera(&top, &settings)?;
+    let mut scene = Scene::new(camera, settings);
+    for t in top.tables("textures", TEXTURE)? {
+        b.texture(&mut scene, &t)?;
+    }
+    for m in top.tables("materials", MATERIAL)? {
+        b.material(&mut scene, &m)?;
+    }
+    if let Some(bg) = top.get("background") {
+        scene.background = b.background(&mut scene, &bg.table(BACKGROUND)?)?;
+    }
+    for s in top.tables("shapes", SHAPE)? {
+        b.shape(&mut scene, &s)?;
+    }
+    for l in top.tables("lights", LIGHT)? {
+        scene.lights.push(b.light(&l)?);
+    }
+    scene.build_accel(&BuildOptions::default());
+    Ok(scene)
+}
+
+struct Builder<'a> {
+    doc: &'a Doc<'a>,
+    resolver: &'a Resolver,
+    texture_ids: HashMap<String, raylab_render::TextureId>,
+    material_ids: HashMap<String, MaterialId>,
+    /// MTL materials already converted, by (MTL path, index).
+    mtl_cache: HashMap<(String, usize), MaterialId>,
+}
+
+fn positive(v: &Val, x: f32) -> Result<f32, LoadError> {
+    if x > 0.0 {
+        Ok(x)
+    } else {
+        Err(v.err(format!("must be positive, found {x}")))
+    }
+}
+
+fn in_range(v: &Val, x: i64, lo: i64, hi: i64) -> Result<i64, LoadError> {
+    if (lo..=hi).contains(&x) {
+        Ok(x)
+    } else {
+        Err(v.err(format!("must be between {lo} and {hi}, found {x}")))
+    }
+}
+
+impl Builder<'_> {
+    fn settings(&self, top: &Table, o: &Overrides) -> Result<RenderSettings, LoadError> {
+        let mut s = RenderSettings::default();
+        if let Some(c) = top.get("camera") {
+            let c = c.table(CAMERA)?;
+            if let Some(v) = c.get("width") {
+                s.width = in_range(&v, v.integer()?, 1, 16384)? as u32;
+            }
+            if let Some(v) = c.get("height") {
+                s.height = in_range(&v, v.integer()?, 1, 16384)? as u32;
+            }
+        }
+        let mut spp_field = None;
+        if let Some(r) = top.get("render") {
+            let r = r.table(RENDER)?;
+            if let Some(v) = r.get("spp") {
+                s.spp = in_range(&v, v.integer()?, 1, 1 << 20)? as u32;
+                spp_field = Some(v);
+            }
+            if let Some(v) = r.get("sampler") {
+                s.sampler = v.str()?.parse().map_err(|e: String| v.err(e))?;
+            }
+            if let Some(v) = r.get("max_depth") {
+                s.max_depth = in_range(&v, v.integer()?, 1, 1024)? as u32;
+            }
+            if let Some(v) = r.get("integrator") {
+                s.integrator = v.str()?.parse().map_err(|e: String| v.err(e))?;
+            }
+            if let Some(v) = r.get("accel") {
+                s.accel = v.str()?.parse().map_err(|e: raylab_accel::UnknownAccel| v.err(e.to_string()))?;
+            }
+            if let Some(v) = r.get("seed") {
+                s.seed = in_range(&v, v.integer()?, 0, i64::MAX)? as u64;
+            }
+        }
+        s.width = o.width.unwrap_or(s.width);
+        s.height = o.height.unwrap_or(s.height);
+        s.spp = o.spp.unwrap_or(s.spp);
+        s.max_depth = o.max_depth.unwrap_or(s.max_depth);
+        s.sampler = o.sampler.unwrap_or(s.sampler);
+        s.integrator = o.integrator.unwrap_or(s.integrator);
+        s.accel = o.accel.unwrap_or(s.accel);
+        s.seed = o.seed.unwrap_or(s.seed);
+        if let Err(e) = s.sampler.check_spp(s.spp) {
+            return Err(match (o.spp, spp_field) {
+                (None, Some(v)) => v.err(e),
+                _ => LoadError::new(self.doc.file, None, "render.spp", e),
+            });
+        }
+        Ok(s)
+    }
+
+    fn camera(&self, top: &Table, s: &RenderSettings) -> Result<Camera, LoadError> {
+        let c = top.req("camera")?.table(CAMERA)?;
+        let from = c.req("from")?.vec3()?;
+        let at_v = c.req("at")?;
+        let at = at_v.vec3()?;
+        let up_v = c.get("up");
+        let up = up_v.as_ref().map(|v| v.vec3()).transpose()?.unwrap_or(Vec3::Y);
+        let vfov_v = c.req("vfov")?;
+        let vfov = vfov_v.f32()?;
+        if !(vfov > 0.0 && vfov < 180.0) {
+            return Err(vfov_v.err(format!("must be in (0, 180) degrees, found {vfov}")));
+        }
+        let aperture = c.opt("aperture", |v| v.f32())?.unwrap_or(0.0);
+        if aperture < 0.0 {
+            return Err(c.get("aperture").unwrap().err(format!("must not be negative, found {aperture}")));
+        }
+        let focus = c.opt("focus_distance", |v| positive(v, v.f32()?))?;
+        Camera::new(from, at, up, vfov, s.width as f32 / s.height as f32, aperture, focus).map_err(|e| {
+            let (field, msg) = e.split_once(": ").unwrap_or(("camera", &e));
+            let span = if field == "camera.up" { up_v.as_ref().unwrap_or(&at_v).span() } else { at_v.span() };
+            self.doc.err(&span, field, msg)
+        })
+    }
+
+    fn find(&self, v: &Val) -> Result<Found, LoadError> {
+        let name = v.str()?;
+        self.resolver.find(name).map_err(|tried| v.err(not_found_message(name, &tried)))
+    }
+
+    fn image_texture(&self, v: &Val, found: &Found, srgb: bool, wrap: Wrap, filter: Filter) -> Result<ImageTexture, LoadError> {
+        let (w, h, texels) = crate::image_io::read_image(&found.path(), srgb).map_err(|e| v.err(e.to_string()))?;
+        ImageTexture::new(w, h, texels, wrap, filter).map_err(|e| v.err(format!("{}: {e}", found.path().display())))
+    }
+
+    fn texture(&mut self, scene: &mut Scene, t: &Table) -> Result<(), LoadError> {
+        let name_v = t.req("name")?;
+        let name = name_v.str()?.to_string();
+        if self.texture_ids.contains_key(&name) {
+            return Err(name_v.err(format!("a texture named `{name}` already exists")));
+        }
+        let kind = t.type_name(&["image", "checker", "noise", "constant"])?;
+        let only = |keys: &[&str]| -> Result<(), LoadError> {
+            for k in TEXTURE {
+                if !["name", "type"].contains(k) && !keys.contains(k) && t.has(k) {
+                    return Err(t.get(k).unwrap().err(format!("not a field of `{kind}` textures (valid: name, type, {})", keys.join(", "))));
+                }
+            }
+            Ok(())
+        };
+        let tex = match kind {
+            "image" => {
+                only(&["file", "wrap", "filter", "srgb"])?;
+                let file = t.req("file")?;
+                let found = self.find(&file)?;
+                let wrap = t.opt("wrap", |v| v.str()?.parse::<Wrap>().map_err(|e| v.err(e.to_string())))?.unwrap_or(Wrap::Repeat);
+                let filter = t.opt("filter", |v| v.str()?.parse::<Filter>().map_err(|e| v.err(e.to_string())))?.unwrap_or(Filter::Bilinear);
+                let srgb = t.opt("srgb", |v| v.bool())?.unwrap_or(true);
+                Texture::Image(self.image_texture(&file, &found, srgb, wrap, filter)?)
+            }
+            "checker" => {
+                only(&["even", "odd", "scale", "space"])?;
+                let even = t.opt("even", |v| v.color())?.unwrap_or(Rgb::splat(0.8));
+                let odd = t.opt("odd", |v| v.color())?.unwrap_or(Rgb::splat(0.2));
+                let scale = t.opt("scale", |v| positive(v, v.f32()?))?.unwrap_or(10.0);
+                let space = t.opt("space", |v| v.str()?.parse::<CheckerSpace>().map_err(|e| v.err(e.to_string())))?.unwrap_or(CheckerSpace::Uv);
+                Texture::Checker(Checker { even, odd, scale, space })
+            }
+            "noise" => {
+                only(&["kind", "scale", "colors", "octaves", "seed"])?;
+                let kind = t.opt("kind", |v| v.str()?.parse::<NoiseKind>().map_err(|e| v.err(e.to_string())))?.unwrap_or(NoiseKind::Marble);
+                let scale = t.opt("scale", |v| positive(v, v.f32()?))?.unwrap_or(4.0);
+                let colors = match t.get("colors") {
+                    Some(v) => {
+                        let a = v.array()?;
+                        if a.len() != 2 {
+                            return Err(v.err(format!("expected an array of 2 colours, found {} elements", a.len())));
+                        }
+                        let c = |k: usize| Val { doc: v.doc, field: format!("{}[{k}]", v.field), value: &a[k] }.color();
+                        [c(0)?, c(1)?]
+                    }
+                    None => [Rgb::ZERO, Rgb::ONE],
+                };
+                let octaves = t.opt("octaves", |v| in_range(v, v.integer()?, 1, 16))?.unwrap_or(7) as u32;
+                let seed = t.opt("seed", |v| in_range(v, v.integer()?, 0, i64::MAX))?.unwrap_or(0) as u64;
+                Texture::Noise(Noise::new(kind, scale, colors, octaves, seed))
+            }
+            _ => {
+                only(&["color"])?;
+                Texture::Constant(t.req("color")?.color()?)
+            }
+        };
+        let id = scene.add_texture(name.clone(), tex);
+        self.texture_ids.insert(name, id);
+        Ok(())
+    }
+
+    /// A colour parameter: a colour, or the name of a texture.
+    fn tex_color(&self, v: &Val) -> Result<TexColor, LoadError> {
+        if let Ok(name) = v.str() {
+            return self.texture_ids.get(name).map(|&id| TexColor::Texture(id)).ok_or_else(|| {
+                let mut names: Vec<&str> = self.texture_ids.keys().map(String::as_str).collect();
+                names.sort();
+                v.err(format!("unknown texture `{name}` (defined: {})", if names.is_empty() { "none".into() } else { names.join(", ") }))
+            });
+        }
+        v.color().map(TexColor::Constant)
+    }
+
+    fn material(&mut self, scene: &mut Scene, t: &Table) -> Result<(), LoadError> {
+        let name_v = t.req("name")?;
+        let name = name_v.str()?.to_string();
+        if self.material_ids.contains_key(&name) {
+            return Err(name_v.err(format!("a material named `{name}` already exists")));
+        }
+        let kind = t.type_name(&["diffuse", "phong", "mirror", "dielectric"])?;
+        let valid: &[&str] = match kind {
+            "diffuse" => &["albedo"],
+            "phong" => &["ka", "kd", "ks", "exponent"],
+            "mirror" => &["reflectance"],
+            _ => &["ior"],
+        };
+        for k in MATERIAL {
+            if !["name", "type"].contains(k) && !valid.contains(k) && t.has(k) {
+                return Err(t.get(k).unwrap().err(format!("not a field of `{kind}` materials (valid: name, type, {})", valid.join(", "))));
+            }
+        }
+        let color = |key: &str, default: Rgb| -> Result<TexColor, LoadError> { t.get(key).map(|v| self.tex_color(&v)).transpose().map(|c| c.unwrap_or(TexColor::Constant(default))) };
+        let m = match kind {
+            "diffuse" => Material::Diffuse { albedo: color("albedo", Rgb::splat(0.5))? },
+            "phong" => Material::Phong {
+                ka: color("ka", Rgb::ZERO)?,
+                kd: color("kd", Rgb::splat(0.5))?,
+                ks: color("ks", Rgb::ZERO)?,
+                exponent: t.opt("exponent", |v| {
+                    let e = v.f32()?;
+                    if e < 0.0 {
+                        Err(v.err(format!("must not be negative, found {e}")))
+                    } else {
+                        Ok(e)
+                    }
+                })?
+                .unwrap_or(32.0),
+            },
+            "mirror" => Material::Mirror { reflectance: color("reflectance", Rgb::ONE)? },
+            _ => Material::Dielectric { ior: t.opt("ior", |v| positive(v, v.f32()?))?.unwrap_or(1.5) },
+        };
+        let id = scene.add_material(name.clone(), m);
+        self.material_ids.insert(name, id);
+        Ok(())
+    }
+
+    fn material_ref(&self, t: &Table) -> Result<Option<MaterialId>, LoadError> {
+        let Some(v) = t.get("material") else { return Ok(None) };
+        let name = v.str()?;
+        self.material_ids.get(name).copied().map(Some).ok_or_else(|| {
+            let mut names: Vec<&str> = self.material_ids.keys().map(String::as_str).collect();
+            names.sort();
+            v.err(format!("unknown material `{name}` (defined: {})", if names.is_empty() { "none".into() } else { names.join(", ") }))
+        })
+    }
+
+    fn background(&mut self, scene: &mut Scene, t: &Table) -> Result<Background, LoadError> {
+        match (t.get("color"), t.get("texture")) {
+            (Some(_), Some(v)) => Err(v.err("give either `color` or `texture`, not both")),
+            (Some(c), None) => Ok(Background::Color(c.color()?)),
+            (None, Some(v)) => {
+                let found = self.find(&v)?;
+                let tex = self.image_texture(&v, &found, true, Wrap::Repeat, Filter::Bilinear)?;
+                Ok(Background::Texture(scene.add_texture(format!("background:{}", v.str()?), Texture::Image(tex))))
+            }
+            (None, None) => Ok(Background::Color(Rgb::ZERO)),
+        }
+    }
+
+    fn transform(&self, t: &Table) -> Result<Transform, LoadError> {
+        let Some(v) = t.get("transform") else { return Ok(Transform::IDENTITY) };
+        let steps = v.array().map_err(|_| v.err("expected an array of steps like [{ scale = 2 }, { translate = [0, 1, 0] }]"))?;
+        let mut m = Transform::IDENTITY;
+        for (i, step) in steps.iter().enumerate() {
+            let sv = Val { doc: self.doc, field: format!("{}[{i}]", v.field), value: step };
+            let st = sv.table(TRANSFORM_STEP)?;
+            let keys: Vec<&str> = TRANSFORM_STEP.iter().copied().filter(|k| st.has(k)).collect();
+            if keys.len() != 1 {
+                return Err(sv.err("each step needs exactly one of scale, rotate, translate"));
+            }
+            let step_t = match keys[0] {
+                "scale" => {
+                    let s = st.get("scale").unwrap();
+                    let f = match s.floats::<3>() {
+                        Ok(a) => Vec3::from_array(a),
+                        Err(_) => Vec3::splat(s.f32().map_err(|_| s.err("expected a number or an array of 3 numbers"))?),
+                    };
+                    Transform::scale(f).ok_or_else(|| s.err("scale must not be zero"))?
+                }
+                "rotate" => {
+                    let r = st.get("rotate").unwrap().table(ROTATE)?;
+                    let axis = r.req("axis")?;
+                    let deg = r.req("degrees")?.f32()?;
+                    Transform::rotate(axis.vec3()?, deg).ok_or_else(|| axis.err("the axis must not be zero"))?
+                }
+                _ => Transform::translate(st.get("translate").unwrap().vec3()?),
+            };
+            m = m.then(step_t);
+        }
+        Ok(m)
+    }
+
+    fn shape(&mut self, scene: &mut Scene, t: &Table) -> Result<(), LoadError> {
+        let kind = t.type_name(&["sphere", "triangle", "quad", "mesh"])?;
+        let valid: &[&str] = match kind {
+            "sphere" => &["center", "radius"],
+            "triangle" => &["vertices", "normals", "uvs"],
+            "quad" => &["vertices", "uvs"],
+            _ => &["file", "smooth"],
+        };
+        for k in SHAPE {
+            if !["type", "material", "transform"].contains(k) && !valid.contains(k) && t.has(k) {
+                return Err(t.get(k).unwrap().err(format!("not a field of `{kind}` shapes (valid: type, material, transform, {})", valid.join(", "))));
+            }
+        }
+        let material = self.material_ref(t)?;
+        let to_world = self.transform(t)?;
+        let mat = material.unwrap_or_default();
+        match kind {
+            "sphere" => {
+                let center = t.opt("center", |v| v.vec3())?.unwrap_or(Vec3::ZERO);
+                let rv = t.req("radius")?;
+                let radius = positive(&rv, rv.f32()?)?;
+                scene.geometry.add_sphere(Sphere { center, radius, to_world, material: mat });
+            }
+            "triangle" | "quad" => {
+                let n = if kind == "triangle" { 3 } else { 4 };
+                let vv = t.req("vertices")?;
+                let verts = vv.points().map_err(|_| vv.err(format!("expected an array of {n} points [x, y, z]")))?;
+                if verts.len() != n {
+                    return Err(vv.err(format!("expected {n} vertices, found {}", verts.len())));
+                }
+                let mut mesh = TriangleMesh { name: kind.into(), positions: verts.iter().map(|&p| to_world.point(p)).collect(), material: mat, ..Default::default() };
+                mesh.indices = if n == 3 { vec![[0, 1, 2]] } else { vec![[0, 1, 2], [0, 2, 3]] };
+                if let Some(nv) = t.get("normals") {
+                    let normals = nv.points()?;
+                    if normals.len() != n || normals.iter().any(|v| v.length_squared() == 0.0) {
+                        return Err(nv.err(format!("expected {n} non-zero normals")));
+                    }
+                    mesh.normals = normals.iter().map(|&v| to_world.normal(v).normalize()).collect();
+                }
+                match t.get("uvs") {
+                    Some(uv) => {
+                        let a = uv.array()?;
+                        if a.len() != n {
+                            return Err(uv.err(format!("expected {n} coordinates [u, v], found {}", a.len())));
+                        }
+                        mesh.uvs = a.iter().enumerate().map(|(k, e)| Val { doc: self.doc, field: format!("{}[{k}]", uv.field), value: e }.vec2()).collect::<Result<_, _>>()?;
+                    }
+                    None if n == 4 => mesh.uvs = vec![Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0)],
+                    None => {}
+                }
+                scene.geometry.add_mesh(mesh);
+            }
+            _ => {
+                let fv = t.req("file")?;
+                let found = self.find(&fv)?;
+                let smooth = t.opt("smooth", |v| v.bool())?.unwrap_or(false);
+                let obj = load_obj(&found, &to_world)?;
+                for (mut mesh, mtl) in obj.meshes {
+                    mesh.material = match (material, mtl) {
+                        (Some(m), _) => m,
+                        (None, Some(k)) if k < obj.materials.len() => self.mtl_material(scene, &fv, &obj.materials, k, obj.mtl_dir.as_ref())?,
+                        _ => MaterialId::default(),
+                    };
+                    if smooth && mesh.normals.is_empty() {
+                        mesh.compute_smooth_normals();
+                    }
+                    scene.geometry.add_mesh(mesh);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Converts an MTL material (once per file and index).
+    fn mtl_material(&mut self, scene: &mut Scene, v: &Val, mats: &[MtlMaterial], k: usize, mtl: Option<&Found>) -> Result<MaterialId, LoadError> {
+        let key = (mtl.map(|f| f.path().display().to_string()).unwrap_or_default(), k);
+        if let Some(&id) = self.mtl_cache.get(&key) {
+            return Ok(id);
+        }
+        let m = &mats[k];
+        let kd = match (&m.diffuse_texture, mtl) {
+            (Some(file), Some(mtl)) => {
+                let found = mtl.sibling_resolver().find(file).map_err(|tried| v.err(format!("map_Kd of material `{}`: {}", m.name, not_found_message(file, &tried))))?;
+                let tex = self.image_texture(v, &found, true, Wrap::Repeat, Filter::Bilinear)?;
+                TexColor::Texture(scene.add_texture(format!("{}:map_Kd", m.name), Texture::Image(tex)))
+            }
+            _ => TexColor::Constant(mtl_color(m.diffuse, Rgb::splat(0.5))),
+        };
+        let ks = mtl_color(m.specular, Rgb::ZERO);
+        let illum = m.illumination_model.unwrap_or(2);
+        let material = if matches!(illum, 4 | 6 | 7) || m.dissolve.is_some_and(|d| d < 1.0) {
+            Material::Dielectric { ior: m.optical_density.filter(|&n| n > 0.0).unwrap_or(1.5) }
+        } else if illum == 3 && ks.max_element() > 0.0 {
+            Material::Mirror { reflectance: TexColor::Constant(ks) }
+        } else if ks.max_element() > 0.0 {
+            Material::Phong { ka: TexColor::Constant(mtl_color(m.ambient, Rgb::ZERO)), kd, ks: TexColor::Constant(ks), exponent: m.shininess.unwrap_or(32.0).max(0.0) }
+        } else {
+            Material::Diffuse { albedo: kd }
+        };
+        let id = scene.add_material(m.name.clone(), material);
+        self.mtl_cache.insert(key, id);
+        Ok(id)
+    }
+
+    fn light(&self, t: &Table) -> Result<Light, LoadError> {
+        let kind = t.type_name(&["point", "directional", "ambient"])?;
+        let valid: &[&str] = match kind {
+            "point" => &["position", "intensity"],
+            "directional" => &["direction", "irradiance"],
+            _ => &["intensity"],
+        };
+        for k in LIGHT {
+            if *k != "type" && !valid.contains(k) && t.has(k) {
+                return Err(t.get(k).unwrap().err(format!("not a field of `{kind}` lights (valid: type, {})", valid.join(", "))));
+            }
+        }
+        Ok(match kind {
+            "point" => Light::Point { position: t.req("position")?.vec3()?, intensity: t.req("intensity")?.color()? },
+            "directional" => {
+                let dv = t.req("direction")?;
+                let direction = dv.vec3()?.try_normalize().ok_or_else(|| dv.err("must not be zero"))?;
+                Light::Directional { direction, irradiance: t.req("irradiance")?.color()? }
+            }
+            _ => Light::Ambient { intensity: t.req("intensity")?.color()? },
+        })
+    }
+}
+
+/// A bare mesh (OBJ or `.obj.gz`) as a scene: a camera framing its bounds from the front
+/// and above, a point light beside the camera, the default material.
+pub fn load_mesh_scene(path: &Path, overrides: &Overrides) -> Result<Scene, LoadError> {
+    let found = Found::Disk(path.to_path_buf());
+    if !path.is_file() {
+        return Err(LoadError::file(path, "cannot read: no such file"));
+    }
+    let obj = load_obj(&found, &Transform::IDENTITY)?;
+    let mut geometry = raylab_render::Geometry::default();
+    for (mesh, _) in obj.meshes {
+        geometry.add_mesh(mesh);
+    }
+    let b = geometry.total_bounds();
+    if b.is_empty() {
+        return Err(LoadError::file(path, "the mesh has no triangles"));
+    }
+    let mut settings = RenderSettings::default();
+    settings.width = overrides.width.unwrap_or(settings.width);
+    settings.height = overrides.height.unwrap_or(settings.height);
+    settings.spp = overrides.spp.unwrap_or(settings.spp);
+    settings.max_depth = overrides.max_depth.unwrap_or(settings.max_depth);
+    settings.sampler = overrides.sampler.unwrap_or(settings.sampler);
+    settings.integrator = overrides.integrator.unwrap_or(settings.integrator);
+    settings.accel = overrides.accel.unwrap_or(settings.accel);
+    settings.seed = overrides.seed.unwrap_or(settings.seed);
+    settings.sampler.check_spp(settings.spp).map_err(|e| LoadError::new(path, None, "--spp", e))?;
+    let center = b.centroid();
+    let radius = 0.5 * b.extent().length();
+    let from = center + Vec3::new(0.35, 0.45, 1.0).normalize() * radius * 2.6;
+    let camera = Camera::new(from, center, Vec3::Y, 40.0, settings.width as f32 / settings.height as f32, 0.0, None).map_err(|e| LoadError::file(path, e))?;
+    let mut scene = Scene::new(camera, settings);
+    scene.geometry = geometry;
+    scene.lights.push(Light::Point { position: from + Vec3::new(-radius, radius, 0.0), intensity: Rgb::splat(3.0 * radius * radius) });
+    scene.lights.push(Light::Ambient { intensity: Rgb::splat(0.1) });
+    scene.build_accel(&BuildOptions::default());
+    Ok(scene)
+}

@@ -1,0 +1,74 @@
+//! Integrators: how radiance along a camera ray is estimated.
+
+pub mod heatmap;
+mod whitted;
+
+use std::fmt;
+use std::str::FromStr;
+
+use raylab_accel::Counters;
+use raylab_core::{Pcg32, Ray, Rgb};
+
+use crate::Scene;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IntegratorKind {
+    /// Recursive ray tracing (Whitted 1980): Phong with point lights, shadows, mirror
+    /// reflection and Fresnel-weighted refraction.
+    Whitted,
+    /// Shading normals as colours (`0.5 · (n + 1)`), for checking geometry.
+    Normals,
+    /// Acceleration-structure nodes visited by each camera ray, in false colour.
+    Heatmap,
+    /// Ray–primitive tests made by each camera ray, in false colour.
+    HeatmapTests,
+}
+
+impl IntegratorKind {
+    pub const ALL: &'static [IntegratorKind] = &[IntegratorKind::Whitted, IntegratorKind::Normals, IntegratorKind::Heatmap, IntegratorKind::HeatmapTests];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            IntegratorKind::Whitted => "whitted",
+            IntegratorKind::Normals => "normals",
+            IntegratorKind::Heatmap => "heatmap",
+            IntegratorKind::HeatmapTests => "heatmap-tests",
+        }
+    }
+
+    /// Whether the output holds raw costs to be colourised by [`heatmap::colorize`].
+    pub fn is_heatmap(self) -> bool {
+        matches!(self, IntegratorKind::Heatmap | IntegratorKind::HeatmapTests)
+    }
+
+    pub fn names() -> String {
+        Self::ALL.iter().map(|k| k.name()).collect::<Vec<_>>().join(", ")
+    }
+
+    /// Radiance arriving along `ray` (a camera ray).
+    pub fn radiance(self, scene: &Scene, ray: &Ray, rng: &mut Pcg32, counters: &mut Counters) -> Rgb {
+        let _ = rng; // Whitted is deterministic; sampling integrators use the stream.
+        match self {
+            IntegratorKind::Whitted => whitted::radiance(scene, ray, 1, counters),
+            IntegratorKind::Normals => match scene.intersect(ray, counters) {
+                Some(h) => 0.5 * (h.geom.ns + Rgb::ONE),
+                None => Rgb::ZERO,
+            },
+            IntegratorKind::Heatmap => heatmap::cost(scene, ray, heatmap::HeatMetric::NodesVisited, counters),
+            IntegratorKind::HeatmapTests => heatmap::cost(scene, ray, heatmap::HeatMetric::PrimTests, counters),
+        }
+    }
+}
+
+impl fmt::Display for IntegratorKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for IntegratorKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL.iter().copied().find(|k| k.name() == s).ok_or_else(|| format!("unknown integrator `{s}` (valid: {})", Self::names()))
+    }
+}

@@ -1,0 +1,75 @@
+use raylab_core::Vec3;
+
+/// Mirror direction of `wo` (pointing away from the surface) about `n`.
+#[inline]
+pub fn reflect(wo: Vec3, n: Vec3) -> Vec3 {
+    2.0 * wo.dot(n) * n - wo
+}
+
+/// Refracted direction of `wo` (pointing away from the surface, on the side of `n`) through
+/// an interface with relative index `eta = n_transmitted / n_incident`, or `None` under total
+/// internal reflection (Snell's law; pbrt-v4 §9.3.2).
+pub fn refract(wo: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
+    let cos_i = wo.dot(n);
+    let sin2_i = (1.0 - cos_i * cos_i).max(0.0);
+    let sin2_t = sin2_i / (eta * eta);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    Some(-wo / eta + (cos_i / eta - cos_t) * n)
+}
+
+/// Fresnel reflectance of a smooth dielectric interface for unpolarised light: the mean of
+/// the s- and p-polarised Fresnel equations. `cos_i` is taken on the side of the normal the
+/// light arrives from (negative = from inside); `eta = n_inside / n_outside`.
+pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
+    let (cos_i, eta) = if cos_i < 0.0 { (-cos_i, 1.0 / eta) } else { (cos_i, eta) };
+    let cos_i = cos_i.min(1.0);
+    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
+    let r_parl = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    0.5 * (r_parl * r_parl + r_perp * r_perp)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fresnel_known_values() {
+        // Normal incidence: ((n-1)/(n+1))² = 0.04 for n = 1.5.
+        assert!((fresnel_dielectric(1.0, 1.5) - 0.04).abs() < 1e-6);
+        assert!((fresnel_dielectric(-1.0, 1.5) - 0.04).abs() < 1e-6);
+        // Grazing incidence reflects everything.
+        assert!((fresnel_dielectric(0.0, 1.5) - 1.0).abs() < 1e-6);
+        // Brewster's angle: p-polarised reflectance vanishes, so F = R_s / 2.
+        let theta_b = 1.5f32.atan();
+        let cos_i = theta_b.cos();
+        let cos_t = (1.0 - (theta_b.sin() / 1.5).powi(2)).sqrt();
+        let rs = ((cos_i - 1.5 * cos_t) / (cos_i + 1.5 * cos_t)).powi(2);
+        assert!((fresnel_dielectric(cos_i, 1.5) - 0.5 * rs).abs() < 1e-6);
+        // Beyond the critical angle from inside: total internal reflection.
+        let critical = (1.0f32 / 1.5).asin();
+        assert_eq!(fresnel_dielectric(-(critical + 0.01).cos(), 1.5), 1.0);
+    }
+
+    #[test]
+    fn snell_law_holds() {
+        let n = Vec3::Z;
+        let wo = Vec3::new(0.6, 0.0, 0.8);
+        let wt = refract(wo, n, 1.5).unwrap();
+        assert!((wt.length() - 1.0).abs() < 1e-5);
+        let sin_i = 0.6f32;
+        let sin_t = (wt.x * wt.x + wt.y * wt.y).sqrt();
+        assert!((sin_i - 1.5 * sin_t).abs() < 1e-5);
+        assert!(wt.z < 0.0 && wt.x < 0.0);
+        // From the dense side at a grazing angle: total internal reflection.
+        assert!(refract(Vec3::new(0.9, 0.0, 0.43589).normalize(), n, 1.0 / 1.5).is_none());
+        assert_eq!(reflect(wo, n), Vec3::new(-0.6, 0.0, 0.8));
+    }
+}

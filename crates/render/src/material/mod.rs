@@ -1,0 +1,70 @@
+//! Materials: what a surface does with light. Whitted shading reads their parameters
+//! directly (`integrator/whitted.rs`).
+
+mod fresnel;
+
+pub use fresnel::{fresnel_dielectric, reflect, refract};
+
+use raylab_core::{Rgb, Vec2, Vec3};
+
+use crate::texture::Texture;
+
+/// Index of a material in [`crate::Scene::materials`]; 0 is the default grey diffuse.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct MaterialId(pub u32);
+
+/// Index of a texture in [`crate::Scene::textures`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct TextureId(pub u32);
+
+/// A colour parameter: a constant or a texture lookup.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TexColor {
+    Constant(Rgb),
+    Texture(TextureId),
+}
+
+impl TexColor {
+    #[inline]
+    pub fn eval(&self, textures: &[Texture], uv: Vec2, p: Vec3) -> Rgb {
+        match *self {
+            TexColor::Constant(c) => c,
+            TexColor::Texture(t) => textures[t.0 as usize].eval(uv, p),
+        }
+    }
+}
+
+impl From<Rgb> for TexColor {
+    fn from(c: Rgb) -> Self {
+        TexColor::Constant(c)
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Material {
+    /// Lambertian reflection, BRDF `albedo / π`.
+    Diffuse { albedo: TexColor },
+    /// The classic Phong model (Phong 1975) as the seeds use it:
+    /// `ka·I_ambient + Σ (kd·cos θ + ks·max(0, r·v)^exponent) · I / d²`.
+    Phong { ka: TexColor, kd: TexColor, ks: TexColor, exponent: f32 },
+    /// Ideal specular reflection scaled by `reflectance`.
+    Mirror { reflectance: TexColor },
+    /// Smooth dielectric (glass, water): Snell refraction weighted by the exact unpolarised
+    /// Fresnel term; total internal reflection. `ior` is inside over outside (outside = 1).
+    Dielectric { ior: f32 },
+}
+
+impl Material {
+    pub fn default_diffuse() -> Self {
+        Material::Diffuse { albedo: TexColor::Constant(Rgb::splat(0.5)) }
+    }
+
+    pub fn type_name(&self) -> &'static str {
+        match self {
+            Material::Diffuse { .. } => "diffuse",
+            Material::Phong { .. } => "phong",
+            Material::Mirror { .. } => "mirror",
+            Material::Dielectric { .. } => "dielectric",
+        }
+    }
+}

@@ -1,0 +1,138 @@
+use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Primitives};
+use raylab_core::{offset_ray_origin, Ray, Rgb, Vec3};
+
+use crate::camera::Camera;
+use crate::integrator::IntegratorKind;
+use crate::light::Light;
+use crate::material::{Material, MaterialId, TextureId};
+use crate::sampler::SamplerKind;
+use crate::shape::{Geometry, SurfaceGeometry};
+use crate::texture::{equirect_uv, Texture};
+
+/// What is seen where no geometry is hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Background {
+    Color(Rgb),
+    /// An equirectangular texture looked up by ray direction.
+    Texture(TextureId),
+}
+
+/// How to render: the `[render]` table of a scene, overridable from the command line.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel; a square number for the jittered sampler.
+    pub spp: u32,
+    pub sampler: SamplerKind,
+    /// Maximum number of path segments from the camera (1 = only what the camera sees).
+    pub max_depth: u32,
+    pub integrator: IntegratorKind,
+    pub accel: AccelKind,
+    pub seed: u64,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self { width: 640, height: 480, spp: 4, sampler: SamplerKind::Jittered, max_depth: 8, integrator: IntegratorKind::Whitted, accel: AccelKind::Bvh, seed: 0 }
+    }
+}
+
+/// A hit with everything shading needs.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceHit {
+    pub t: f32,
+    pub prim: u32,
+    pub geom: SurfaceGeometry,
+    pub material: MaterialId,
+}
+
+impl SurfaceHit {
+    /// A ray leaving the surface towards `dir`, its origin moved off the surface robustly.
+    pub fn spawn(&self, dir: Vec3) -> Ray {
+        Ray::new(offset_ray_origin(self.geom.p, self.geom.p_error, self.geom.ng, dir), dir)
+    }
+
+    /// A shadow ray towards a point at distance `dist` along unit `wi` (∞ for directional
+    /// lights). Stops just short of the target so it cannot hit what the target lies on.
+    pub fn spawn_to(&self, wi: Vec3, dist: f32) -> Ray {
+        let o = offset_ray_origin(self.geom.p, self.geom.p_error, self.geom.ng, wi);
+        Ray::segment(o, wi, 0.0, dist * (1.0 - 1e-4))
+    }
+}
+
+/// A scene ready to render: geometry and its acceleration structure, materials, textures,
+/// lights, camera and settings. Everything in world space.
+#[derive(Debug)]
+pub struct Scene {
+    pub camera: Camera,
+    pub settings: RenderSettings,
+    pub geometry: Geometry,
+    pub materials: Vec<Material>,
+    pub material_names: Vec<String>,
+    pub textures: Vec<Texture>,
+    pub texture_names: Vec<String>,
+    pub lights: Vec<Light>,
+    pub background: Background,
+    accel: AnyAccel,
+}
+
+impl Scene {
+    /// An empty scene holding the default material (id 0).
+    pub fn new(camera: Camera, settings: RenderSettings) -> Self {
+        let geometry = Geometry::default();
+        let accel = AnyAccel::build(AccelKind::None, &geometry, &BuildOptions::default());
+        Self {
+            camera,
+            settings,
+            geometry,
+            materials: vec![Material::default_diffuse()],
+            material_names: vec!["default".into()],
+            textures: Vec::new(),
+            texture_names: Vec::new(),
+            lights: Vec::new(),
+            background: Background::Color(Rgb::ZERO),
+            accel,
+        }
+    }
+
+    /// (Re)builds the acceleration structure named in the settings; call after the geometry
+    /// changes.
+    pub fn build_accel(&mut self, opts: &BuildOptions) {
+        self.accel = AnyAccel::build(self.settings.accel, &self.geometry, opts);
+    }
+
+    pub fn accel(&self) -> &AnyAccel {
+        &self.accel
+    }
+
+    /// Closest hit along the ray.
+    pub fn intersect(&self, ray: &Ray, counters: &mut Counters) -> Option<SurfaceHit> {
+        debug_assert_eq!(self.accel.stats().primitives, self.geometry.len(), "build_accel() after adding geometry");
+        let h = self.accel.intersect(&self.geometry, ray, counters)?;
+        Some(SurfaceHit { t: h.t, prim: h.prim, geom: self.geometry.surface(ray, h.prim, h.t, h.u, h.v), material: self.geometry.material(h.prim) })
+    }
+
+    pub fn occluded(&self, ray: &Ray, counters: &mut Counters) -> bool {
+        self.accel.occluded(&self.geometry, ray, counters)
+    }
+
+    pub fn background(&self, dir: Vec3) -> Rgb {
+        match self.background {
+            Background::Color(c) => c,
+            Background::Texture(t) => self.textures[t.0 as usize].eval(equirect_uv(dir.normalize()), dir),
+        }
+    }
+
+    pub fn add_material(&mut self, name: impl Into<String>, m: Material) -> MaterialId {
+        self.materials.push(m);
+        self.material_names.push(name.into());
+        MaterialId(self.materials.len() as u32 - 1)
+    }
+
+    pub fn add_texture(&mut self, name: impl Into<String>, t: Texture) -> TextureId {
+        self.textures.push(t);
+        self.texture_names.push(name.into());
+        TextureId(self.textures.len() as u32 - 1)
+    }
+}

@@ -1,0 +1,97 @@
+use raylab_core::{intersect, Aabb, Ray, Vec2, Vec3};
+
+use super::SurfaceGeometry;
+use crate::material::MaterialId;
+
+/// A triangle mesh in world space (transforms are applied when it is loaded), with
+/// optional per-vertex normals and texture coordinates sharing the position indices.
+#[derive(Clone, Debug, Default)]
+pub struct TriangleMesh {
+    pub name: String,
+    pub positions: Vec<Vec3>,
+    /// Empty, or one unit normal per position.
+    pub normals: Vec<Vec3>,
+    /// Empty, or one coordinate per position.
+    pub uvs: Vec<Vec2>,
+    pub indices: Vec<[u32; 3]>,
+    pub material: MaterialId,
+}
+
+impl TriangleMesh {
+    pub fn len(&self) -> usize {
+        self.indices.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.indices.is_empty()
+    }
+
+    #[inline]
+    pub fn vertices(&self, tri: u32) -> [Vec3; 3] {
+        let [a, b, c] = self.indices[tri as usize];
+        [self.positions[a as usize], self.positions[b as usize], self.positions[c as usize]]
+    }
+
+    pub fn triangle_bounds(&self, tri: u32) -> Aabb {
+        Aabb::from_points(self.vertices(tri))
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        Aabb::from_points(self.indices.iter().flatten().map(|&i| self.positions[i as usize]))
+    }
+
+    #[inline]
+    pub fn intersect(&self, tri: u32, ray: &Ray) -> Option<(f32, f32, f32)> {
+        let [a, b, c] = self.vertices(tri);
+        intersect::triangle(ray, a, b, c)
+    }
+
+    /// Surface data at barycentrics `(b1, b2)`. The point comes from the barycentrics, not
+    /// from `o + t·d`, which keeps it on the plane. Without vertex UVs, `uv = (b1, b2)`.
+    pub fn surface(&self, tri: u32, b1: f32, b2: f32) -> SurfaceGeometry {
+        let idx = self.indices[tri as usize].map(|i| i as usize);
+        let [p0, p1, p2] = idx.map(|i| self.positions[i]);
+        let b0 = 1.0 - b1 - b2;
+        let p = b0 * p0 + b1 * p1 + b2 * p2;
+        // Error of the barycentric interpolation (pbrt-v4 §6.8.6).
+        let p_error = raylab_core::gamma(7) * ((b0 * p0).abs() + (b1 * p1).abs() + (b2 * p2).abs());
+        let e1 = p1 - p0;
+        let e2 = p2 - p0;
+        let mut ng = e1.cross(e2).try_normalize().unwrap_or(Vec3::Y);
+        let (uv, dpdu) = if self.uvs.is_empty() {
+            (Vec2::new(b1, b2), e1)
+        } else {
+            let [t0, t1, t2] = idx.map(|i| self.uvs[i]);
+            let (d1, d2) = (t1 - t0, t2 - t0);
+            let det = d1.x * d2.y - d1.y * d2.x;
+            let dpdu = if det.abs() > 1e-12 { (d2.y * e1 - d1.y * e2) / det } else { e1 };
+            (b0 * t0 + b1 * t1 + b2 * t2, dpdu)
+        };
+        let ns = if self.normals.is_empty() {
+            ng
+        } else {
+            let [n0, n1, n2] = idx.map(|i| self.normals[i]);
+            let n = (b0 * n0 + b1 * n1 + b2 * n2).try_normalize().unwrap_or(ng);
+            // Orient the geometric normal like the interpolated one (pbrt does the same), so
+            // that "outside" agrees between the two whatever the winding order.
+            if n.dot(ng) < 0.0 {
+                ng = -ng;
+            }
+            n
+        };
+        SurfaceGeometry { p, p_error, ng, ns, uv, dpdu }
+    }
+
+    /// Area-weighted vertex normals (for `smooth = true` on meshes without normals).
+    pub fn compute_smooth_normals(&mut self) {
+        let mut n = vec![Vec3::ZERO; self.positions.len()];
+        for &[a, b, c] in &self.indices {
+            let (pa, pb, pc) = (self.positions[a as usize], self.positions[b as usize], self.positions[c as usize]);
+            let face = (pb - pa).cross(pc - pa); // length = 2 × area
+            for i in [a, b, c] {
+                n[i as usize] += face;
+            }
+        }
+        self.normals = n.into_iter().map(|v| v.try_normalize().unwrap_or(Vec3::Y)).collect();
+    }
+}

@@ -1,0 +1,118 @@
+//! Shapes and the scene's geometry: the list of primitives that acceleration structures
+//! index into.
+
+mod mesh;
+mod sphere;
+
+use std::ops::Range;
+
+pub use mesh::TriangleMesh;
+pub use sphere::Sphere;
+
+use raylab_accel::{PrimHit, Primitives};
+use raylab_core::{Aabb, Ray, Vec2, Vec3};
+
+use crate::material::MaterialId;
+
+/// Local surface data at a hit.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceGeometry {
+    pub p: Vec3,
+    /// Conservative bound on the absolute error of each coordinate of `p`, for robust
+    /// spawning of secondary rays ([`raylab_core::offset_ray_origin`]).
+    pub p_error: Vec3,
+    /// Unit geometric normal (outward for spheres; for meshes, agreeing with `ns`).
+    pub ng: Vec3,
+    /// Unit shading normal (interpolated vertex normals, or `ng`).
+    pub ns: Vec3,
+    pub uv: Vec2,
+    /// ∂p/∂u, for tangent frames; not normalised.
+    pub dpdu: Vec3,
+}
+
+/// Which shape a primitive belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PrimRef {
+    Triangle { mesh: u32, tri: u32 },
+    Sphere(u32),
+}
+
+/// All shapes of a scene, flattened into primitives. Each shape's primitives are
+/// consecutive, so each shape is one object for per-object bounding boxes.
+#[derive(Clone, Debug, Default)]
+pub struct Geometry {
+    pub meshes: Vec<TriangleMesh>,
+    pub spheres: Vec<Sphere>,
+    prims: Vec<PrimRef>,
+    objects: Vec<Range<u32>>,
+}
+
+impl Geometry {
+    pub fn add_mesh(&mut self, mesh: TriangleMesh) {
+        let m = self.meshes.len() as u32;
+        let start = self.prims.len() as u32;
+        self.prims.extend((0..mesh.len() as u32).map(|tri| PrimRef::Triangle { mesh: m, tri }));
+        self.objects.push(start..self.prims.len() as u32);
+        self.meshes.push(mesh);
+    }
+
+    pub fn add_sphere(&mut self, sphere: Sphere) {
+        let s = self.spheres.len() as u32;
+        let start = self.prims.len() as u32;
+        self.prims.push(PrimRef::Sphere(s));
+        self.objects.push(start..start + 1);
+        self.spheres.push(sphere);
+    }
+
+    pub fn prim(&self, i: u32) -> PrimRef {
+        self.prims[i as usize]
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.meshes.iter().map(|m| m.len()).sum()
+    }
+
+    pub fn material(&self, prim: u32) -> MaterialId {
+        match self.prims[prim as usize] {
+            PrimRef::Triangle { mesh, .. } => self.meshes[mesh as usize].material,
+            PrimRef::Sphere(s) => self.spheres[s as usize].material,
+        }
+    }
+
+    /// Surface data for a hit reported by an acceleration structure.
+    pub fn surface(&self, ray: &Ray, prim: u32, t: f32, u: f32, v: f32) -> SurfaceGeometry {
+        match self.prims[prim as usize] {
+            PrimRef::Triangle { mesh, tri } => self.meshes[mesh as usize].surface(tri, u, v),
+            PrimRef::Sphere(s) => self.spheres[s as usize].surface(ray, t),
+        }
+    }
+
+    pub fn total_bounds(&self) -> Aabb {
+        raylab_accel::primitives::total_bounds(self)
+    }
+}
+
+impl Primitives for Geometry {
+    fn len(&self) -> usize {
+        self.prims.len()
+    }
+
+    fn bounds(&self, i: u32) -> Aabb {
+        match self.prims[i as usize] {
+            PrimRef::Triangle { mesh, tri } => self.meshes[mesh as usize].triangle_bounds(tri),
+            PrimRef::Sphere(s) => self.spheres[s as usize].bounds(),
+        }
+    }
+
+    #[inline]
+    fn intersect(&self, i: u32, ray: &Ray) -> Option<PrimHit> {
+        match self.prims[i as usize] {
+            PrimRef::Triangle { mesh, tri } => self.meshes[mesh as usize].intersect(tri, ray).map(|(t, u, v)| PrimHit { t, u, v }),
+            PrimRef::Sphere(s) => self.spheres[s as usize].intersect(ray).map(|t| PrimHit { t, u: 0.0, v: 0.0 }),
+        }
+    }
+
+    fn objects(&self) -> Vec<Range<u32>> {
+        self.objects.clone()
+    }
+}

@@ -1,0 +1,62 @@
+use raylab_core::{intersect, Aabb, Ray, Transform, Vec2, Vec3};
+use std::f32::consts::PI;
+
+use super::SurfaceGeometry;
+use crate::material::MaterialId;
+
+/// A sphere in object space, placed in the world by `to_world` (which may scale it
+/// non-uniformly into an ellipsoid).
+#[derive(Clone, Debug)]
+pub struct Sphere {
+    pub center: Vec3,
+    pub radius: f32,
+    pub to_world: Transform,
+    pub material: MaterialId,
+}
+
+impl Sphere {
+    pub fn bounds(&self) -> Aabb {
+        let r = Vec3::splat(self.radius);
+        self.to_world.bounds(&Aabb::new(self.center - r, self.center + r))
+    }
+
+    fn object_ray(&self, ray: &Ray) -> Ray {
+        if self.to_world.is_identity() {
+            return *ray;
+        }
+        // The same `t` parametrises both rays because the direction is not renormalised.
+        Ray { origin: self.to_world.inv.transform_point3(ray.origin), dir: self.to_world.inv.transform_vector3(ray.dir), ..*ray }
+    }
+
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<f32> {
+        intersect::sphere(&self.object_ray(ray), self.center, self.radius)
+    }
+
+    /// Surface data at the hit distance `t`. UVs are longitude/latitude: `u` runs once
+    /// around the y axis starting at -x, `v` from the south pole (0) to the north pole (1),
+    /// the mapping of *Ray Tracing: The Next Week* for equirectangular maps.
+    pub fn surface(&self, ray: &Ray, t: f32) -> SurfaceGeometry {
+        let r = self.object_ray(ray);
+        let local = (r.at(t) - self.center).try_normalize().unwrap_or(Vec3::Y);
+        // Re-project onto the surface: removes the error of `o + t·d`.
+        let p_obj = self.center + self.radius * local;
+        let theta = (-local.y).clamp(-1.0, 1.0).acos();
+        let phi = (-local.z).atan2(local.x) + PI;
+        let uv = Vec2::new(phi / (2.0 * PI), theta / PI);
+        // ∂p/∂u points along increasing longitude; used for tangent frames (normal maps).
+        let dpdu_obj = Vec3::new(local.z, 0.0, -local.x) * (-2.0 * PI * self.radius);
+        let n = self.to_world.normal(local).normalize();
+        // Reprojection leaves a relative error of γ₅ per coordinate (pbrt-v4 §6.8.5); the
+        // transform adds its own rounding (§6.8.4).
+        let err_obj = raylab_core::gamma(5) * p_obj.abs();
+        let p_error = if self.to_world.is_identity() {
+            err_obj
+        } else {
+            let m = glam::Mat3::from(self.to_world.m.matrix3);
+            let abs_m = glam::Mat3::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
+            abs_m * err_obj + raylab_core::gamma(3) * (abs_m * p_obj.abs() + Vec3::from(self.to_world.m.translation).abs())
+        };
+        SurfaceGeometry { p: self.to_world.point(p_obj), p_error, ng: n, ns: n, uv, dpdu: self.to_world.vector(dpdu_obj) }
+    }
+}
