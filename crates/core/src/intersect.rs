@@ -2,7 +2,7 @@
 
 use glam::{DVec3, Vec3};
 
-use crate::Ray;
+use crate::{gamma, Ray};
 
 /// Watertight ray–triangle intersection (Woop, Benthin & Wald, JCGT 2013).
 ///
@@ -60,6 +60,21 @@ pub fn triangle(ray: &Ray, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<(f32, f32, f3
     if !(t > ray.t_min && t <= ray.t_max) {
         return None;
     }
+    // A hit this close to the origin may be rounding error of a ray leaving this very
+    // triangle: reject t below its error bound (pbrt-v4 §6.8.4), which is what makes the
+    // tiny offsets of `offset_ray_origin` safe.
+    let max_zt = az.abs().max(bz.abs()).max(cz.abs());
+    let max_xt = ax.abs().max(bx.abs()).max(cx.abs());
+    let max_yt = ay.abs().max(by.abs()).max(cy.abs());
+    let delta_z = gamma(3) * max_zt;
+    let delta_x = gamma(5) * (max_xt + max_zt);
+    let delta_y = gamma(5) * (max_yt + max_zt);
+    let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+    let max_e = u.abs().max(v.abs()).max(w.abs());
+    let delta_t = 3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+    if t <= delta_t {
+        return None;
+    }
     Some((t, v * inv_det, w * inv_det))
 }
 
@@ -107,6 +122,20 @@ mod tests {
 
     fn tri() -> (Vec3, Vec3, Vec3) {
         (Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0))
+    }
+
+    #[test]
+    fn rays_leaving_a_triangle_do_not_hit_it_again() {
+        // A ground quad's triangle at y = 0 and a ray that left it with the smallest offset
+        // `offset_ray_origin` gives at y = 0 (one ulp: 1e-45). Without the t error bound
+        // the shear rounds this to a hit at t ≈ 2e-8 (found by `raylab bench` on the bunny).
+        let (a, b, c) = (Vec3::new(-5.0, 0.0, -5.0), Vec3::new(5.0, 0.0, -5.0), Vec3::new(5.0, 0.0, 5.0));
+        let r = Ray::new(Vec3::new(-3.360861, 1e-45, -4.7802467), Vec3::new(0.5225498, 0.35702893, -0.7742558));
+        assert_eq!(triangle(&r, a, b, c), None);
+        // The same ray pointing down still hits, at the hand-computed distance 1e-45 / dy.
+        let down = Ray::new(Vec3::new(-3.360861, 1.0, -4.7802467), Vec3::new(0.5225498, -0.35702893, 0.7742558));
+        let (t, _, _) = triangle(&down, a, b, c).unwrap();
+        assert!((t - 1.0 / 0.35702893).abs() < 1e-5, "{t}");
     }
 
     #[test]

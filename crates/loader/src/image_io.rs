@@ -27,9 +27,10 @@ fn err(path: &Path, message: impl Into<String>) -> ImageError {
 }
 
 /// How linear radiance becomes a displayable value in [0, 1] before sRGB encoding.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Tonemap {
     /// Clip at 1 (the classic ray tracer's behaviour).
+    #[default]
     Clamp,
     /// `c / (1 + c)` per channel (Reinhard et al. 2002, simple form).
     Reinhard,

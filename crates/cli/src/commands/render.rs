@@ -20,7 +20,7 @@ pub struct RenderArgs {
     pub output: Option<PathBuf>,
     /// Tone map for 8-bit outputs: clamp, reinhard or aces
     #[arg(long, default_value = "clamp")]
-    pub tonemap: String,
+    pub tonemap: Tonemap,
     /// Exposure in stops applied before tone mapping
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
@@ -35,7 +35,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     if !["png", "ppm", "exr", "pfm"].contains(&ext.as_str()) {
         bail!("{}: unknown image format `.{ext}` (valid: {})", out.display(), image_io::image_format_names());
     }
-    let tonemap: Tonemap = a.tonemap.parse().map_err(|e| anyhow::anyhow!("--tonemap: {e}"))?;
+    let tonemap = a.tonemap;
     if !a.exposure.is_finite() {
         bail!("--exposure: expected a finite number");
     }

@@ -10,7 +10,7 @@ use raylab_render::{IntegratorKind, SamplerKind, Scene};
 
 #[derive(Args, Clone, Debug, Default)]
 pub struct SceneArgs {
-    /// Scene file (TOML); the embedded default scene when omitted
+    /// Scene file (TOML) or bare mesh (OBJ, .obj.gz); the embedded default scene when omitted
     pub scene: Option<PathBuf>,
     /// Image width in pixels (overrides the scene's)
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
@@ -72,7 +72,7 @@ impl SceneArgs {
     pub fn load(&self) -> Result<Scene> {
         let o = self.overrides()?;
         Ok(match &self.scene {
-            Some(p) => raylab_loader::load_scene(p, &o)?,
+            Some(p) => raylab_loader::load_scene_or_mesh(p, &o)?,
             None => raylab_loader::default_scene(&o)?,
         })
     }

@@ -82,16 +82,53 @@ impl TriangleMesh {
         SurfaceGeometry { p, p_error, ng, ns, uv, dpdu }
     }
 
-    /// Area-weighted vertex normals (for `smooth = true` on meshes without normals).
+    /// Angle-weighted vertex normals (Thürmer & Wüthrich 1998) for `smooth = true` on meshes
+    /// without normals. Vertices at the same position are welded first, so meshes split
+    /// along UV seams (the teapot's patches) shade without a visible crease.
     pub fn compute_smooth_normals(&mut self) {
-        let mut n = vec![Vec3::ZERO; self.positions.len()];
-        for &[a, b, c] in &self.indices {
-            let (pa, pb, pc) = (self.positions[a as usize], self.positions[b as usize], self.positions[c as usize]);
-            let face = (pb - pa).cross(pc - pa); // length = 2 × area
-            for i in [a, b, c] {
-                n[i as usize] += face;
+        let mut group_of = std::collections::HashMap::new();
+        let groups: Vec<usize> = self.positions.iter().map(|p| {
+            let next = group_of.len();
+            *group_of.entry(p.to_array().map(|c| (c + 0.0).to_bits())).or_insert(next)
+        }).collect();
+        let mut n = vec![Vec3::ZERO; group_of.len()];
+        for &tri in &self.indices {
+            let p = tri.map(|i| self.positions[i as usize]);
+            let Some(face) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else { continue };
+            for k in 0..3 {
+                let angle = (p[(k + 1) % 3] - p[k]).angle_between(p[(k + 2) % 3] - p[k]);
+                if angle.is_finite() {
+                    n[groups[tri[k] as usize]] += angle * face;
+                }
             }
         }
-        self.normals = n.into_iter().map(|v| v.try_normalize().unwrap_or(Vec3::Y)).collect();
+        self.normals = groups.iter().map(|&g| n[g].try_normalize().unwrap_or(Vec3::Y)).collect();
+    }
+
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn smooth_normals_weld_split_vertices_and_weight_by_angle() {
+        // A roof: two faces meeting at the ridge x = 0, the ridge vertices duplicated.
+        let mut mesh = TriangleMesh {
+            positions: vec![
+                Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 1.0), Vec3::new(-1.0, 0.0, 0.0),
+                Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 1.0),
+            ],
+            indices: vec![[0, 2, 1], [3, 5, 4]],
+            ..Default::default()
+        };
+        mesh.compute_smooth_normals();
+        // Both copies of each ridge vertex get the average of the two faces: straight up.
+        for i in [0, 1, 3, 5] {
+            assert!((mesh.normals[i] - Vec3::Y).length() < 1e-6, "{i}: {}", mesh.normals[i]);
+        }
+        // The eaves belong to one face each.
+        let left = Vec3::new(-1.0, 1.0, 0.0).normalize();
+        assert!((mesh.normals[2] - left).length() < 1e-6, "{}", mesh.normals[2]);
     }
 }
