@@ -1,0 +1,159 @@
+//! The `raylab` command as a user meets it: exit codes, exact error messages, files written,
+//! and a render compared with a stored reference image.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use raylab_loader::image_io::read_image;
+
+fn raylab(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_raylab")).args(args).current_dir(dir).output().expect("raylab runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().unwrap()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("raylab-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Runs raylab expecting failure with exactly `message` (after `raylab: error: `) and no panic.
+fn fails_with(args: &[&str], dir: &Path, message: &str) {
+    let o = raylab(args, dir);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+    assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+    assert_eq!(err.trim_end(), format!("raylab: error: {message}"), "{args:?}");
+}
+
+#[test]
+fn the_bare_command_renders_the_default_scene() {
+    let dir = scratch("default");
+    let o = raylab(&["render", "--width", "80", "--height", "60", "--spp", "1"], &dir);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (w, h, pixels) = read_image(&dir.join("raylab.png"), true).unwrap();
+    assert_eq!((w, h), (80, 60));
+    // Not a blank image: sky, floor and objects give many distinct values.
+    let mut lum: Vec<u32> = pixels.iter().map(|p| (p.x * 1000.0) as u32).collect();
+    lum.sort_unstable();
+    lum.dedup();
+    assert!(lum.len() > 50, "only {} distinct values", lum.len());
+    let summary = stderr(&o);
+    assert!(summary.contains("Rendered the default scene at 80×60, 1 spp"), "{summary}");
+    assert!(summary.contains("Mrays/s"), "{summary}");
+}
+
+/// Mean squared error and largest absolute difference between two linear images.
+fn difference(a: &[raylab_core::Rgb], b: &[raylab_core::Rgb]) -> (f64, f32) {
+    let mut sum = 0.0f64;
+    let mut max = 0.0f32;
+    for (p, q) in a.iter().zip(b) {
+        let d = *p - *q;
+        sum += (d.x * d.x + d.y * d.y + d.z * d.z) as f64 / 3.0;
+        max = max.max(d.abs().max_element());
+    }
+    (sum / a.len() as f64, max)
+}
+
+#[test]
+fn renders_match_the_stored_references() {
+    // Regenerate with RAYLAB_BLESS=1 after an intended change of the images, and look at them.
+    let refs = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/reference");
+    let dir = scratch("reference");
+    for scene in ["spheres_phong", "mirror_glass", "procedural"] {
+        let out = dir.join(format!("{scene}.pfm"));
+        let path = repo().join(format!("scenes/{scene}.toml"));
+        let o = raylab(&["render", path.to_str().unwrap(), "--width", "64", "--height", "48", "--spp", "4", "-q", "-o", out.to_str().unwrap()], &dir);
+        assert!(o.status.success(), "{scene}: {}", stderr(&o));
+        let reference = refs.join(format!("{scene}.pfm"));
+        if std::env::var_os("RAYLAB_BLESS").is_some() {
+            std::fs::copy(&out, &reference).unwrap();
+        }
+        let (w, h, got) = read_image(&out, false).unwrap();
+        let (rw, rh, want) = read_image(&reference, false).unwrap();
+        assert_eq!((w, h), (rw, rh));
+        assert!(got.iter().all(|p| p.is_finite()));
+        let (mse, max) = difference(&got, &want);
+        // Same seed, same image; the bound leaves room for other compilers' floating point.
+        assert!(mse < 1e-5 && max < 0.25, "{scene}: mse {mse}, max {max}");
+    }
+}
+
+#[test]
+fn bad_input_fails_with_file_line_and_field() {
+    let dir = scratch("bad");
+    let write = |name: &str, text: &str| std::fs::write(dir.join(name), text).unwrap();
+    let camera = "[camera]\nfrom = [0, 0, 5]\nat = [0, 0, 0]\nvfov = 40\n";
+    write("string.toml", "[camera]\nfrom = [0,0,5]\nat = \"origin\"\nvfov = 40\n");
+    fails_with(&["render", "string.toml"], &dir, "string.toml:3: camera.at: expected an array of 3 numbers, found a string");
+    write("radius.toml", &format!("{camera}[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = -1\n"));
+    fails_with(&["render", "radius.toml"], &dir, "radius.toml:8: shapes[0].radius: must be positive, found -1");
+    write("missing.toml", &format!("{camera}[[shapes]]\ntype = \"mesh\"\nfile = \"nope.obj\"\n"));
+    fails_with(&["inspect", "missing.toml"], &dir, "missing.toml:7: shapes[0].file: cannot find `nope.obj` (looked in nope.obj)");
+    write("vfov.toml", "[camera]\nfrom = [0, 0, 5]\nat = [0, 0, 0]\nvfov = 180\n");
+    fails_with(&["render", "vfov.toml"], &dir, "vfov.toml:4: camera.vfov: must be in (0, 180) degrees, found 180");
+    write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+    fails_with(&["render", "bad.obj"], &dir, "bad.obj:4: face index 4 is out of range: the file has 3 vertex (`v`) entries");
+    fails_with(&["render", "absent.toml"], &dir, "absent.toml: cannot read: No such file or directory (os error 2)");
+    fails_with(&["render", "-o", "out.bmp"], &dir, "out.bmp: unknown image format `.bmp` (valid: png, ppm, exr, pfm)");
+    fails_with(
+        &["render", "--accel", "octree"],
+        &dir,
+        "--accel: unknown acceleration structure `octree` (valid: none, bvh, bvh-median, bvh-midpoint, aabb, grid, lbvh, lbvh-ploc, kdtree, sphere-bvh, sbvh)",
+    );
+    fails_with(&["trace", "radius.toml", "--rays", "absent.rays"], &dir, "absent.rays: cannot open: No such file or directory (os error 2)");
+    assert!(!dir.join("raylab.png").exists(), "a failed render must not write an image");
+}
+
+#[test]
+fn bench_agrees_with_the_oracle_and_trace_reproduces_it() {
+    let dir = scratch("bench");
+    let cube = repo().join("scenes/cube.toml");
+    let o = raylab(&["bench", cube.to_str().unwrap(), "--accels", "all", "--resolution", "24", "--repeats", "1", "--json", "b.json", "--dump-rays", "rays"], &dir);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("b.json")).unwrap()).unwrap();
+    let results = json["results"].as_array().unwrap();
+    let accels: Vec<&str> = results.iter().map(|r| r["accel"].as_str().unwrap()).collect();
+    assert_eq!(accels, ["none", "bvh", "bvh-median", "bvh-midpoint", "aabb", "grid", "lbvh", "lbvh-ploc", "kdtree", "sphere-bvh", "sbvh"]);
+    let oracle = &results[0]["rays"]["primary"];
+    for r in results {
+        assert_eq!(r["rays"]["primary"]["hits"], oracle["hits"], "{}", r["accel"]);
+        assert_eq!(r["rays"]["primary"]["t_sum"], oracle["t_sum"], "{}", r["accel"]);
+        assert_eq!(r["primitives"], 14);
+    }
+    // `trace` on the dumped rays gives the bench's answers.
+    let o = raylab(&["trace", cube.to_str().unwrap(), "--rays", "rays/cube-primary.rays", "--accel", "kdtree", "--json"], &dir);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let t: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(t["hits"], oracle["hits"]);
+    assert_eq!(t["t_sum"], oracle["t_sum"]);
+    assert_eq!(t["rays"], oracle["count"]);
+}
+
+#[test]
+fn generated_scenes_have_the_expected_size() {
+    let dir = scratch("gen");
+    let o = raylab(&["gen", "tetra", "--size", "3", "-o", "tetra.toml"], &dir);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = raylab(&["inspect", "tetra.toml", "--json"], &dir);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    // A Sierpinski tetrahedron of depth 3: 4³ tetrahedra of 4 triangles, plus the 2-triangle floor.
+    assert_eq!(j["counts"]["triangles"], 4 * 64 + 2, "{j}");
+}
+
+#[test]
+fn help_explains_every_render_option() {
+    let o = raylab(&["render", "--help"], Path::new("."));
+    let help = String::from_utf8_lossy(&o.stdout);
+    for option in ["--width", "--height", "--spp", "--threads", "--seed", "--accel", "--output", "--tonemap", "--exposure", "--integrator", "--sampler"] {
+        assert!(help.contains(option), "render --help lacks {option}");
+    }
+}
