@@ -27,6 +27,27 @@ pub struct RenderArgs {
     /// No progress bar or summary
     #[arg(short, long)]
     pub quiet: bool,
+    /// Print the summary as JSON on stdout (counters included: rays, node visits,
+    /// primitive tests, object-box tests)
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(serde::Serialize)]
+struct Summary<'a> {
+    scene: String,
+    width: u32,
+    height: u32,
+    spp: u32,
+    accel: &'a str,
+    threads: usize,
+    primitives: usize,
+    build_ms: f64,
+    render_seconds: f64,
+    mrays_per_s: f64,
+    counters: raylab_accel::Counters,
+    nonfinite_samples: u64,
+    output: String,
 }
 
 pub fn run(a: &RenderArgs) -> Result<()> {
@@ -50,13 +71,33 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         let output = raylab_render::render(&scene, &|n| bar.inc(n));
         bar.finish_and_clear();
         image_io::write_image(&out, output.width, output.height, &output.pixels, tonemap, a.exposure)?;
+        let g = &scene.geometry;
+        let stats = scene.accel().stats();
+        let threads = rayon::current_num_threads();
+        if a.json {
+            let summary = Summary {
+                scene: a.scene.scene_name(),
+                width: s.width,
+                height: s.height,
+                spp: s.spp,
+                accel: &stats.name,
+                threads,
+                primitives: g.len(),
+                build_ms: stats.build_ms,
+                render_seconds: output.seconds,
+                mrays_per_s: output.mrays_per_second(),
+                counters: output.counters,
+                nonfinite_samples: output.nonfinite_samples,
+                output: out.display().to_string(),
+            };
+            println!("{}", serde_json::to_string_pretty(&summary)?);
+        }
         if !a.quiet {
-            let g = &scene.geometry;
-            let stats = scene.accel().stats();
-            let threads = rayon::current_num_threads();
+            let c = &output.counters;
+            let per_ray = |n: u64| n as f64 / c.rays.max(1) as f64;
             eprintln!(
                 "Rendered {} at {}×{}, {} spp ({}), integrator {}, max depth {}: {} primitives ({} triangles, {} spheres), {} lights; \
-                 {} acceleration structure built in {:.1} ms after {:.2} s of loading. Traced {:.2} M rays in {:.2} s ({:.2} Mrays/s on {threads} threads){}. Wrote {}.",
+                 {} acceleration structure built in {:.1} ms after {:.2} s of loading. Traced {:.2} M rays in {:.2} s ({:.2} Mrays/s on {threads} threads){}; per ray {:.1} nodes visited and {:.1} primitive tests. Wrote {}.",
                 a.scene.scene_name(),
                 s.width,
                 s.height,
@@ -75,6 +116,8 @@ pub fn run(a: &RenderArgs) -> Result<()> {
                 output.seconds,
                 output.mrays_per_second(),
                 if output.nonfinite_samples > 0 { format!("; {} non-finite samples dropped", output.nonfinite_samples) } else { String::new() },
+                per_ray(c.nodes_visited),
+                per_ray(c.prim_tests),
                 out.display()
             );
         }
