@@ -173,8 +173,13 @@ impl BoundingSphere {
         if dist + self.radius <= o.radius {
             return o;
         }
-        let radius = 0.5 * (dist + self.radius + o.radius);
-        let center = self.center + d * ((radius - self.radius) / dist);
+        // The centre lies on the segment between the centres, at t = ½(1 + (r₂ - r₁)/d);
+        // clamping t and measuring the radius from the rounded centre keeps both inputs
+        // inside even for nearly concentric spheres of nearly equal radii, where
+        // `(radius - r₁) / d` would divide a rounding error by a tiny distance.
+        let t = (0.5 * (1.0 + (o.radius - self.radius) / dist)).clamp(0.0, 1.0);
+        let center = self.center + d * t;
+        let radius = ((center - self.center).length() + self.radius).max((center - o.center).length() + o.radius);
         // Grow by a few ulps so that both inputs stay inside despite rounding.
         Self { center, radius: radius * (1.0 + 4.0 * f32::EPSILON) }
     }
@@ -233,6 +238,24 @@ mod tests {
         assert!((u.center - Vec3::new(2.0, 0.0, 0.0)).length() < 1e-6);
         assert!((u.radius - 3.0).abs() < 1e-5);
         assert_eq!(a.union(BoundingSphere { center: Vec3::ZERO, radius: 0.5 }), a);
+    }
+
+    #[test]
+    fn sphere_union_of_nearly_concentric_spheres_contains_both() {
+        // The 202k-triangle dragon's sphere hierarchy failed validation on such pairs: the
+        // old centre formula divided a rounding error by a distance of a few ulps.
+        let mut rng = crate::rng::Pcg32::new(7, 1);
+        for _ in 0..100_000 {
+            let c = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 0.2 - 0.1;
+            let r = 1e-3 + 1e-2 * rng.next_f32();
+            let a = BoundingSphere { center: c, radius: r };
+            let wiggle = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) - 0.5;
+            let b = BoundingSphere { center: c + wiggle * r * 1e-6, radius: r * (1.0 + 1e-6 * (rng.next_f32() - 0.5)) };
+            let u = a.union(b);
+            for x in [a, b] {
+                assert!((x.center - u.center).length() + x.radius <= u.radius, "{a:?} ∪ {b:?} = {u:?}");
+            }
+        }
     }
 
     #[test]

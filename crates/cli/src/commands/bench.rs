@@ -21,7 +21,8 @@ use raylab_render::IntegratorKind;
 pub struct BenchArgs {
     /// Scene files (.toml) or bare meshes (.obj, .obj.gz); the default scene when none
     pub scenes: Vec<PathBuf>,
-    /// Comma-separated structures, or `all`
+    /// Comma-separated structures, or `all` (which leaves out `none` and `aabb` on scenes
+    /// above --oracle-limit primitives)
     #[arg(long, default_value = "all")]
     pub accels: String,
     /// Comma-separated ray sets: primary, diffuse, shadow
@@ -120,6 +121,16 @@ fn bench_scene(a: &BenchArgs, path: Option<&PathBuf>, accels: &[AccelKind], kind
         }
     }
     let oracle_kind = if prims.len() <= a.oracle_limit { AccelKind::None } else { AccelKind::Bvh };
+    // Structures that test every primitive per ray (per object, for one big mesh) take hours
+    // on large scenes: `all` leaves them out there; naming them keeps them in.
+    let linear = [AccelKind::None, AccelKind::Aabb];
+    let accels: Vec<AccelKind> = if a.accels == "all" && oracle_kind != AccelKind::None {
+        eprintln!("{name}: {} primitives, above --oracle-limit: `all` leaves out none and aabb (name them to include them)", prims.len());
+        accels.iter().copied().filter(|k| !linear.contains(k)).collect()
+    } else {
+        accels.to_vec()
+    };
+    let accels = accels.as_slice();
     let oracle = AnyAccel::build(oracle_kind, prims, &BuildOptions::default());
     let reference: Vec<TraceResult> = sets.iter().map(|s| raylab_lab::trace(&oracle, prims, &s.rays, s.kind.any_hit())).collect();
 
