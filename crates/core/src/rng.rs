@@ -18,11 +18,6 @@ impl Pcg32 {
         r
     }
 
-    /// A stream for pixel `(x, y)` of an image rendered with `seed`.
-    pub fn for_pixel(seed: u64, x: u32, y: u32) -> Self {
-        Self::new(mix64(seed ^ 0x9E37_79B9_7F4A_7C15), ((y as u64) << 32) | x as u64)
-    }
-
     pub fn next_u32(&mut self) -> u32 {
         let old = self.state;
         self.state = old.wrapping_mul(MULT).wrapping_add(self.inc);

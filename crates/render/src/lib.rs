@@ -17,7 +17,7 @@ pub use integrator::IntegratorKind;
 pub use light::Light;
 pub use material::{Material, MaterialId, TexColor, TextureId};
 pub use render::{render, RenderOutput};
-pub use sampler::SamplerKind;
+pub use sampler::{PixelSampler, SamplerKind};
 pub use scene::{Background, RenderSettings, Scene, SurfaceHit};
 pub use shape::{Geometry, Sphere, TriangleMesh};
 pub use texture::Texture;

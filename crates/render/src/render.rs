@@ -5,8 +5,9 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use raylab_accel::Counters;
-use raylab_core::{Pcg32, Rgb, Vec2};
+use raylab_core::{Rgb, Vec2};
 
+use crate::sampler::PixelSampler;
 use crate::Scene;
 
 pub const TILE: u32 = 16;
@@ -74,14 +75,13 @@ pub fn render(scene: &Scene, progress: &(dyn Fn(u64) + Sync)) -> RenderOutput {
 /// The box-filtered mean of the pixel's samples.
 fn render_pixel(scene: &Scene, x: u32, y: u32, c: &mut Counters, bad: &mut u64) -> Rgb {
     let s = &scene.settings;
-    let mut rng = Pcg32::for_pixel(s.seed, x, y);
     let inv = Vec2::new(1.0 / s.width as f32, 1.0 / s.height as f32);
     let mut sum = Rgb::ZERO;
     for i in 0..s.spp {
-        let offset = s.sampler.pixel_offset(i, s.spp, &mut rng);
-        let film = (Vec2::new(x as f32, y as f32) + offset) * inv;
-        let ray = scene.camera.ray(film, rng.next_vec2());
-        let l = s.integrator.radiance(scene, &ray, &mut rng, c);
+        let mut sampler = PixelSampler::new(s.sampler, s.spp, s.seed, x, y, i);
+        let film = (Vec2::new(x as f32, y as f32) + sampler.pixel_2d()) * inv;
+        let ray = scene.camera.ray(film, sampler.get_2d());
+        let l = s.integrator.radiance(scene, &ray, &mut sampler, c);
         if l.is_finite() {
             sum += l;
         } else {

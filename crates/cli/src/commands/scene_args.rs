@@ -21,7 +21,7 @@ pub struct SceneArgs {
     /// Samples per pixel (a square number for the jittered sampler)
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1048576))]
     pub spp: Option<u32>,
-    /// Pixel sampler: random or jittered
+    /// Pixel sampler: random, jittered (stratified) or sobol (scrambled low-discrepancy)
     #[arg(long)]
     pub sampler: Option<String>,
     /// Maximum number of path segments from the camera

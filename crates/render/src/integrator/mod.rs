@@ -7,8 +7,9 @@ use std::fmt;
 use std::str::FromStr;
 
 use raylab_accel::Counters;
-use raylab_core::{Pcg32, Ray, Rgb};
+use raylab_core::{Ray, Rgb};
 
+use crate::sampler::PixelSampler;
 use crate::Scene;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -46,8 +47,8 @@ impl IntegratorKind {
     }
 
     /// Radiance arriving along `ray` (a camera ray).
-    pub fn radiance(self, scene: &Scene, ray: &Ray, rng: &mut Pcg32, counters: &mut Counters) -> Rgb {
-        let _ = rng; // Whitted is deterministic; sampling integrators use the stream.
+    pub fn radiance(self, scene: &Scene, ray: &Ray, sampler: &mut PixelSampler, counters: &mut Counters) -> Rgb {
+        let _ = sampler; // Whitted is deterministic; sampling integrators draw from it.
         match self {
             IntegratorKind::Whitted => whitted::radiance(scene, ray, 1, counters),
             IntegratorKind::Normals => match scene.intersect(ray, counters) {
