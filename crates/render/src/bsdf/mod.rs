@@ -112,8 +112,8 @@ fn lobe_probability(a: Rgb, b: Rgb) -> Option<f32> {
     (la + lb > 0.0).then(|| lb / (la + lb))
 }
 
-/// A delta sample whose lobe weight (`f·|cos θi|/pdf · pdf`) is `weight`: `f = weight/|cos θi|`.
-/// `None` where `|cos θi|` is so small that `f` overflows.
+/// A delta sample carrying the fraction `weight` of the light: `f = weight/|cos θi|`, so
+/// that `f·|cos θi|/pdf` is the throughput factor. `None` where `f` would overflow.
 fn delta_sample(wi: Vec3, weight: Rgb, pdf: f32) -> Option<BsdfSample> {
     let f = weight / wi.z.abs();
     (f.is_finite() && pdf > 0.0).then_some(BsdfSample { wi, f, pdf, delta: true })
