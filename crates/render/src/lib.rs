@@ -2,6 +2,7 @@
 //! loop. It reads no files (that is `raylab-loader`'s job) and knows acceleration
 //! structures only through `raylab-accel`'s trait.
 
+pub mod bsdf;
 pub mod camera;
 pub mod integrator;
 pub mod light;

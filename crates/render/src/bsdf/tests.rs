@@ -1,0 +1,464 @@
+//! BSDF tests: hand-computed values, normalisation, sample/pdf/eval consistency, a
+//! chi-square test of sampling against the pdf, white furnace, reciprocity, and the
+//! dielectric's Fresnel split, total internal reflection and Snell's law. Seeded, so
+//! deterministic.
+
+use std::f64::consts::PI as PI64;
+
+use raylab_core::{Pcg32, Rgb, Vec2, Vec3};
+
+use super::microfacet::schlick;
+use super::*;
+use crate::material::fresnel_dielectric;
+
+/// Unit vector with `cos θ = cos_theta` and azimuth `phi`.
+fn dir(cos_theta: f32, phi: f32) -> Vec3 {
+    let sin = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    Vec3::new(sin * phi.cos(), sin * phi.sin(), cos_theta)
+}
+
+fn close(a: f32, b: f32, rel: f32) -> bool {
+    (a - b).abs() <= rel * a.abs().max(b.abs()) + 1e-12
+}
+
+fn close_rgb(a: Rgb, b: Rgb, rel: f32) -> bool {
+    close(a.x, b.x, rel) && close(a.y, b.y, rel) && close(a.z, b.z, rel)
+}
+
+fn cook_torrance(distribution: Distribution, geometry: Geometry, alpha: f32) -> Bsdf {
+    Bsdf::CookTorrance { diffuse: Rgb::new(0.2, 0.3, 0.1), specular: Rgb::new(0.6, 0.5, 0.7), alpha, distribution, geometry, f0: Rgb::new(0.9, 0.5, 0.04) }
+}
+
+const DISTRIBUTIONS: [Distribution; 2] = [Distribution::Beckmann, Distribution::Ggx];
+const GEOMETRIES: [Geometry; 2] = [Geometry::Smith, Geometry::VCavity];
+
+/// Every non-delta model, with a label for failure messages.
+fn smooth_models() -> Vec<(String, Bsdf)> {
+    let mut v = vec![
+        ("lambert".to_string(), Bsdf::Lambert { albedo: Rgb::new(0.8, 0.5, 0.2) }),
+        ("phong n=1".to_string(), Bsdf::Phong { kd: Rgb::new(0.3, 0.2, 0.1), ks: Rgb::new(0.5, 0.6, 0.7), exponent: 1.0 }),
+        ("phong n=20".to_string(), Bsdf::Phong { kd: Rgb::new(0.3, 0.2, 0.1), ks: Rgb::new(0.5, 0.6, 0.7), exponent: 20.0 }),
+        ("phong specular only".to_string(), Bsdf::Phong { kd: Rgb::ZERO, ks: Rgb::ONE, exponent: 50.0 }),
+    ];
+    for d in DISTRIBUTIONS {
+        for g in GEOMETRIES {
+            for alpha in [0.05, 0.3, 1.0] {
+                v.push((format!("cook-torrance {d} {g} α={alpha}"), cook_torrance(d, g, alpha)));
+            }
+        }
+    }
+    v
+}
+
+/// Outgoing directions from normal to grazing, at assorted azimuths.
+fn wos() -> [Vec3; 4] {
+    [Vec3::Z, dir(0.8, 0.3), dir(0.4, 2.0), dir(0.1, -1.0)]
+}
+
+#[test]
+fn lambert_eval_is_albedo_over_pi() {
+    let albedo = Rgb::new(0.8, 0.5, 0.2);
+    let b = Bsdf::Lambert { albedo };
+    for (wo, wi) in [(Vec3::Z, Vec3::Z), (dir(0.3, 1.0), dir(0.9, -2.0)), (dir(0.01, 0.0), dir(0.5, 3.0))] {
+        assert_eq!(b.eval(wo, wi), albedo / std::f32::consts::PI);
+        assert_eq!(b.eval(wo, -wi), Rgb::ZERO, "below the surface");
+        assert_eq!(b.eval(-wo, wi), Rgb::ZERO, "seen from below");
+    }
+}
+
+#[test]
+fn ndf_peaks_at_one_over_pi_alpha_squared() {
+    for d in DISTRIBUTIONS {
+        for alpha in [0.05f32, 0.3, 1.0] {
+            let expected = 1.0 / (std::f32::consts::PI * alpha * alpha);
+            assert!(close(d.d(Vec3::Z, alpha), expected, 1e-6), "{d} α={alpha}: {} vs {expected}", d.d(Vec3::Z, alpha));
+        }
+    }
+}
+
+#[test]
+fn schlick_is_f0_at_normal_incidence_and_one_at_grazing() {
+    let f0 = Rgb::new(0.04, 0.5, 0.9);
+    assert_eq!(schlick(f0, 1.0), f0);
+    assert_eq!(schlick(f0, 0.0), Rgb::ONE);
+    assert!(close_rgb(schlick(f0, 1e-3), Rgb::ONE, 1e-2));
+    // Hand value: cos = 0.5 gives f0 + (1 − f0)/32.
+    assert!(close_rgb(schlick(f0, 0.5), f0 + (Rgb::ONE - f0) / 32.0, 1e-6));
+    assert_eq!(schlick(Rgb::ONE, 0.37), Rgb::ONE);
+}
+
+#[test]
+fn geometry_terms_hand_values() {
+    for d in DISTRIBUTIONS {
+        for alpha in [0.05, 0.5, 1.0] {
+            // At normal incidence nothing is masked.
+            assert_eq!(Geometry::VCavity.g(d, alpha, Vec3::Z, Vec3::Z, Vec3::Z), 1.0);
+            assert_eq!(Geometry::Smith.g(d, alpha, Vec3::Z, Vec3::Z, Vec3::Z), 1.0);
+        }
+    }
+    // V-cavity with wo = wi = h at θ = 60°: min(1, 2 cos²θ) = 0.5.
+    let w = dir(0.5, 0.7);
+    assert!(close(Geometry::VCavity.g(Distribution::Ggx, 0.3, w, w, w), 0.5, 1e-5));
+    // Smith GGX, θ = 60° both ways, α = 1: Λ = (√(1 + tan²θ) − 1)/2 = (2 − 1)/2, G2 = 1/2.
+    assert!(close(Geometry::Smith.g(Distribution::Ggx, 1.0, w, w, w), 0.5, 1e-5));
+    // Smith Beckmann: a = 1/(α tanθ) ≥ 1.6 means no masking.
+    let steep = dir(0.9, 0.0);
+    assert_eq!(Geometry::Smith.g(Distribution::Beckmann, 0.1, steep, steep, steep), 1.0);
+}
+
+#[test]
+fn ndf_projected_area_is_one() {
+    // ∫ D(h) cos θh dω = 2π ∫ D(θ) cos θ sin θ dθ, midpoint rule in θ.
+    let n = 200_000;
+    let dtheta = std::f64::consts::FRAC_PI_2 / n as f64;
+    for d in DISTRIBUTIONS {
+        for alpha in [0.05f32, 0.1, 0.3, 0.6, 1.0] {
+            let sum: f64 = (0..n)
+                .map(|i| {
+                    let theta = (i as f64 + 0.5) * dtheta;
+                    let h = dir(theta.cos() as f32, 0.4);
+                    d.d(h, alpha) as f64 * theta.cos() * theta.sin()
+                })
+                .sum();
+            let integral = 2.0 * PI64 * sum * dtheta;
+            assert!((integral - 1.0).abs() < 5e-3, "{d} α={alpha}: ∫D cos = {integral}");
+        }
+    }
+}
+
+#[test]
+fn samples_agree_with_eval_and_pdf() {
+    let mut rng = Pcg32::new(1, 2);
+    for (name, b) in smooth_models() {
+        for wo in wos() {
+            for _ in 0..2_000 {
+                let Some(s) = b.sample(wo, rng.next_f32(), rng.next_vec2()) else { continue };
+                assert!(!s.delta && s.wi.z > 0.0 && (s.wi.length() - 1.0).abs() < 1e-4, "{name}: {s:?}");
+                assert_eq!((b.pdf(wo, -s.wi), b.eval(wo, -s.wi)), (0.0, Rgb::ZERO), "{name}: one-sided");
+                assert!(close(s.pdf, b.pdf(wo, s.wi), 1e-4), "{name}: pdf {} vs {}", s.pdf, b.pdf(wo, s.wi));
+                assert!(close_rgb(s.f, b.eval(wo, s.wi), 1e-4), "{name}: f {} vs {}", s.f, b.eval(wo, s.wi));
+            }
+        }
+        assert!(b.sample(-Vec3::Z, 0.5, Vec2::splat(0.5)).is_none(), "{name} sampled from below");
+    }
+}
+
+/// ∫ pdf over the upper hemisphere (one-sided models have none below, see
+/// `samples_agree_with_eval_and_pdf`): midpoint rule in (θ, φ), dω = sin θ dθ dφ. Fine
+/// steps in φ resolve the lobes of grazing `wo`, squeezed sideways near the horizon.
+fn pdf_integral(b: &Bsdf, wo: Vec3) -> f64 {
+    let (nt, np) = (512, 2048);
+    let (dt, dp) = (0.5 * PI64 / nt as f64, 2.0 * PI64 / np as f64);
+    let mut sum = 0.0;
+    for i in 0..nt {
+        let theta = (i as f64 + 0.5) * dt;
+        let ring: f64 = (0..np).map(|j| b.pdf(wo, dir(theta.cos() as f32, ((j as f64 + 0.5) * dp) as f32)) as f64).sum();
+        sum += ring * theta.sin();
+    }
+    sum * dt * dp
+}
+
+#[test]
+fn pdf_integrates_to_sample_acceptance() {
+    // `sample` rejects directions below the horizon, so its density integrates to the
+    // fraction of samples it returns: 1 for Lambert, ≤ 1 otherwise.
+    let mut rng = Pcg32::new(5, 6);
+    for (name, b) in smooth_models() {
+        for wo in wos() {
+            let integral = pdf_integral(&b, wo);
+            let n = 100_000;
+            let accepted = (0..n).filter(|_| b.sample(wo, rng.next_f32(), rng.next_vec2()).is_some()).count() as f64 / n as f64;
+            assert!(integral <= 1.01, "{name} wo={wo}: ∫pdf = {integral}");
+            assert!((integral - accepted).abs() < 0.01, "{name} wo={wo}: ∫pdf = {integral}, accepted {accepted}");
+            if name == "lambert" || (name.starts_with("phong") && wo == Vec3::Z) {
+                assert!((integral - 1.0).abs() < 0.01, "{name} wo={wo}: ∫pdf = {integral}");
+            }
+        }
+    }
+}
+
+/// Chi-square statistic and degrees of freedom comparing where `sample` sends 500 000
+/// directions, over 16 (cos θ) × 32 (φ) bins of the upper hemisphere plus a "rejected"
+/// cell, with the counts the pdf predicts (bins integrated by a 16 × 16 midpoint rule in
+/// (cos θ, φ), where dω = d cos θ dφ). Cells expecting fewer than 5 are pooled.
+fn chi_square(b: &Bsdf, wo: Vec3, seed: u64) -> (f64, usize) {
+    const NZ: usize = 16;
+    const NP: usize = 32;
+    const SUB: usize = 16;
+    let n = 500_000;
+    let two_pi = 2.0 * std::f32::consts::PI;
+    let mut observed = vec![0.0f64; NZ * NP + 1];
+    let mut rng = Pcg32::new(seed, 7);
+    for _ in 0..n {
+        let cell = match b.sample(wo, rng.next_f32(), rng.next_vec2()) {
+            Some(s) => {
+                assert!(s.wi.z > 0.0);
+                let iz = ((s.wi.z * NZ as f32) as usize).min(NZ - 1);
+                let ip = ((s.wi.y.atan2(s.wi.x).rem_euclid(two_pi) / two_pi * NP as f32) as usize).min(NP - 1);
+                iz * NP + ip
+            }
+            None => NZ * NP,
+        };
+        observed[cell] += 1.0;
+    }
+    let (dz, dphi) = (1.0 / NZ as f64, 2.0 * PI64 / NP as f64);
+    let mut expected: Vec<f64> = (0..NZ * NP)
+        .map(|cell| {
+            let (iz, ip) = (cell / NP, cell % NP);
+            let mut sum = 0.0;
+            for (a, c) in (0..SUB * SUB).map(|k| (k / SUB, k % SUB)) {
+                let z = (iz as f64 + (a as f64 + 0.5) / SUB as f64) * dz;
+                let phi = (ip as f64 + (c as f64 + 0.5) / SUB as f64) * dphi;
+                sum += b.pdf(wo, dir(z as f32, phi as f32)) as f64;
+            }
+            sum / (SUB * SUB) as f64 * dz * dphi * n as f64
+        })
+        .collect();
+    let total: f64 = expected.iter().sum();
+    expected.push((n as f64 - total).max(0.0));
+    // Pool the cells expecting little, smallest first.
+    let mut cells: Vec<(f64, f64)> = expected.into_iter().zip(observed).collect();
+    cells.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (mut chi2, mut dof, mut pool) = (0.0, 0usize, (0.0, 0.0));
+    for (e, o) in cells {
+        if e < 5.0 {
+            pool = (pool.0 + e, pool.1 + o);
+            continue;
+        }
+        chi2 += (o - e) * (o - e) / e;
+        dof += 1;
+    }
+    if pool.0 > 0.0 {
+        chi2 += (pool.1 - pool.0) * (pool.1 - pool.0) / pool.0;
+        dof += 1;
+    }
+    (chi2, dof - 1)
+}
+
+#[test]
+fn sample_histogram_matches_pdf() {
+    let models = [
+        ("lambert", Bsdf::Lambert { albedo: Rgb::splat(0.7) }),
+        ("phong n=20", Bsdf::Phong { kd: Rgb::splat(0.3), ks: Rgb::splat(0.6), exponent: 20.0 }),
+        ("cook-torrance ggx α=0.3", cook_torrance(Distribution::Ggx, Geometry::Smith, 0.3)),
+        ("cook-torrance beckmann α=0.3", cook_torrance(Distribution::Beckmann, Geometry::Smith, 0.3)),
+    ];
+    for (i, (name, b)) in models.iter().enumerate() {
+        for (j, wo) in [dir(0.77, 0.5), dir(0.3, 4.0)].into_iter().enumerate() {
+            let (chi2, dof) = chi_square(b, wo, (10 * i + j) as u64);
+            // Mean dof, standard deviation √(2 dof): five deviations up is p ≈ 1e-5.
+            let limit = dof as f64 + 5.0 * (2.0 * dof as f64).sqrt();
+            assert!(chi2 < limit, "{name} wo={wo}: χ² = {chi2:.1} with {dof} dof (limit {limit:.1})");
+        }
+    }
+}
+
+/// E[f cos θi / pdf] over `sample`, with its standard error: the albedo for `wo`.
+fn albedo(b: &Bsdf, wo: Vec3, seed: u64) -> (f64, f64) {
+    let mut rng = Pcg32::new(seed, 9);
+    let n = 200_000;
+    let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+    for _ in 0..n {
+        if let Some(s) = b.sample(wo, rng.next_f32(), rng.next_vec2()) {
+            let w = (s.f.x * s.wi.z / s.pdf) as f64;
+            sum += w;
+            sum2 += w * w;
+        }
+    }
+    let mean = sum / n as f64;
+    (mean, ((sum2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt())
+}
+
+#[test]
+fn white_furnace() {
+    // Closed form: GGX, α = 1, Smith, normal incidence. D = 1/π, wi = 2θh off the normal,
+    // G2 = 2 cos θi / (1 + cos θi): E = 2 ∫₀^{π/4} G2 cos θh sin θh dθh = 1 − ln 2.
+    let ggx =
+        Bsdf::CookTorrance { diffuse: Rgb::ZERO, specular: Rgb::ONE, alpha: 1.0, distribution: Distribution::Ggx, geometry: Geometry::Smith, f0: Rgb::ONE };
+    let (e, se) = albedo(&ggx, Vec3::Z, 99);
+    assert!((e - (1.0 - 2f64.ln())).abs() < 4.0 * se + 1e-3, "GGX α=1 at normal incidence: {e} ± {se}");
+    let lambert = Bsdf::Lambert { albedo: Rgb::ONE };
+    for (k, wo) in wos().into_iter().enumerate() {
+        let (e, _) = albedo(&lambert, wo, k as u64);
+        assert!((e - 1.0).abs() < 1e-3, "lambert wo={wo}: {e}");
+        for exponent in [1.0, 20.0, 200.0] {
+            let phong = Bsdf::Phong { kd: Rgb::splat(0.3), ks: Rgb::splat(0.7), exponent };
+            let (e, se) = albedo(&phong, wo, k as u64);
+            assert!(e <= 1.0 + 4.0 * se + 1e-3, "phong n={exponent} wo={wo}: {e} ± {se}");
+            if wo == Vec3::Z {
+                // At normal incidence the normalised lobe reflects exactly ks.
+                assert!((e - 1.0).abs() < 4.0 * se + 1e-3, "phong n={exponent} at normal incidence: {e} ± {se}");
+            }
+        }
+        for d in DISTRIBUTIONS {
+            for g in GEOMETRIES {
+                for alpha in [0.05, 0.1, 0.3, 0.6, 1.0] {
+                    let b = Bsdf::CookTorrance { diffuse: Rgb::ZERO, specular: Rgb::ONE, alpha, distribution: d, geometry: g, f0: Rgb::ONE };
+                    let (e, se) = albedo(&b, wo, k as u64);
+                    assert!(e <= 1.0 + 4.0 * se + 5e-3, "{d} {g} α={alpha} wo={wo}: {e} ± {se}");
+                    if g == Geometry::Smith && alpha <= 0.1 && wo.z >= 0.8 {
+                        // Little masking: nearly all energy is reflected.
+                        assert!(e >= 0.97, "{d} {g} α={alpha} wo={wo}: {e} ± {se}");
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn reciprocity() {
+    let mut rng = Pcg32::new(11, 12);
+    for (name, b) in smooth_models() {
+        for _ in 0..2_000 {
+            let wo = dir(rng.next_f32(), 6.3 * rng.next_f32());
+            let wi = dir(rng.next_f32(), 6.3 * rng.next_f32());
+            let (a, c) = (b.eval(wo, wi), b.eval(wi, wo));
+            assert!(close_rgb(a, c, 1e-4), "{name}: f({wo}, {wi}) = {a} but f({wi}, {wo}) = {c}");
+        }
+    }
+}
+
+#[test]
+fn delta_lobes_have_no_density() {
+    for b in [Bsdf::Mirror { reflectance: Rgb::ONE }, Bsdf::Dielectric { ior: 1.5 }] {
+        assert!(b.is_delta());
+        let wo = dir(0.6, 1.0);
+        let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+        assert_eq!((b.eval(wo, wi), b.pdf(wo, wi)), (Rgb::ZERO, 0.0));
+    }
+    assert!(smooth_models().iter().all(|(_, b)| !b.is_delta()));
+}
+
+#[test]
+fn mirror_reflects_about_the_normal() {
+    let reflectance = Rgb::new(0.9, 0.6, 0.3);
+    let b = Bsdf::Mirror { reflectance };
+    for wo in wos() {
+        let s = b.sample(wo, 0.3, Vec2::splat(0.6)).expect("mirror sample");
+        assert_eq!(s.wi, Vec3::new(-wo.x, -wo.y, wo.z));
+        assert!(s.delta && s.pdf == 1.0);
+        assert!(close_rgb(s.f * s.wi.z / s.pdf, reflectance, 1e-6));
+    }
+    assert!(b.sample(dir(-0.5, 0.0), 0.3, Vec2::ZERO).is_none());
+}
+
+#[test]
+fn dielectric_reflects_with_fresnel_probability() {
+    let mut rng = Pcg32::new(21, 22);
+    let n = 100_000;
+    for ior in [1.5f32, 1.33] {
+        for cos in [1.0f32, 0.8, 0.5, 0.2, 0.05, -1.0, -0.9, -0.8, -0.5] {
+            let wo = dir(cos, 0.8);
+            let f = fresnel_dielectric(cos, ior);
+            // η = n_transmitted / n_incident as seen from wo.
+            let eta = if cos > 0.0 { ior } else { 1.0 / ior };
+            let mut reflected = 0;
+            for _ in 0..n {
+                let s = Bsdf::Dielectric { ior }.sample(wo, rng.next_f32(), rng.next_vec2()).expect("dielectric sample");
+                assert!(s.delta);
+                let weight = s.f.x * s.wi.z.abs() / s.pdf;
+                if s.wi.z * wo.z > 0.0 {
+                    reflected += 1;
+                    assert!(close(s.pdf, f, 1e-6) && close(weight, 1.0, 1e-5), "reflection {s:?}");
+                } else {
+                    assert!(close(s.pdf, 1.0 - f, 1e-6) && close(weight, 1.0 / (eta * eta), 1e-5), "refraction {s:?}");
+                }
+            }
+            let frac = reflected as f32 / n as f32;
+            let tol = 5.0 * (f * (1.0 - f) / n as f32).sqrt() + 1e-6;
+            assert!((frac - f).abs() <= tol, "ior {ior} cos {cos}: reflected {frac}, Fresnel {f}");
+        }
+    }
+}
+
+#[test]
+fn dielectric_total_internal_reflection() {
+    let ior = 1.5f32;
+    let sin_critical = 1.0 / ior;
+    let mut rng = Pcg32::new(31, 32);
+    for sin in [sin_critical + 1e-3, 0.8, 0.99] {
+        let wo = dir(-(1.0 - sin * sin).sqrt(), 2.5);
+        assert_eq!(fresnel_dielectric(wo.z, ior), 1.0);
+        for _ in 0..1_000 {
+            let s = Bsdf::Dielectric { ior }.sample(wo, rng.next_f32(), rng.next_vec2()).expect("TIR sample");
+            assert_eq!(s.wi, Vec3::new(-wo.x, -wo.y, wo.z), "sinθ = {sin}: must reflect");
+            assert!(s.pdf == 1.0 && close(s.f.x * s.wi.z.abs(), 1.0, 1e-6));
+        }
+    }
+}
+
+#[test]
+fn dielectric_refraction_obeys_snell() {
+    let ior = 1.5f32;
+    let sin_of = |w: Vec3| (w.x * w.x + w.y * w.y).sqrt();
+    // (cos θi, η = n_t/n_i): from outside into glass, and from inside out below the critical angle.
+    for (cos, eta) in [(0.9f32, ior), (0.5, ior), (0.1, ior), (-0.95, 1.0 / ior), (-0.8, 1.0 / ior)] {
+        let wo = dir(cos, 1.2);
+        // u_lobe just below 1 always picks refraction unless F ≈ 1.
+        let s = Bsdf::Dielectric { ior }.sample(wo, 0.99999, Vec2::ZERO).expect("refraction");
+        assert!(s.wi.z * wo.z < 0.0, "crossed the interface");
+        assert!((s.wi.length() - 1.0).abs() < 1e-5);
+        assert!(close(sin_of(s.wi), sin_of(wo) / eta, 1e-4), "cos {cos}: sinθt {} vs {}", sin_of(s.wi), sin_of(wo) / eta);
+        // The transmitted ray continues on the far side of the normal: opposite azimuth.
+        assert!(s.wi.x * wo.x + s.wi.y * wo.y < 0.0 && (s.wi.x * wo.y - s.wi.y * wo.x).abs() < 1e-5);
+    }
+}
+
+#[test]
+fn extreme_inputs_stay_finite() {
+    let cosines = [1.0f32, 0.5, 1e-4, 1e-7, 1e-20, 1e-30, 1e-40, 0.0, -0.0, -1e-30, -1e-7, -0.5, -1.0];
+    let us = [0.0f32, 1e-7, 0.5, 1.0 - f32::EPSILON / 2.0];
+    let mut models = smooth_models();
+    for alpha in [0.0f32, -1.0, 1e-9, 1e-3, 2.0, 10.0] {
+        for d in DISTRIBUTIONS {
+            for g in GEOMETRIES {
+                models.push((format!("{d} {g} α={alpha}"), cook_torrance(d, g, alpha)));
+            }
+        }
+    }
+    for exponent in [0.0, 1e4] {
+        models.push((format!("phong n={exponent}"), Bsdf::Phong { kd: Rgb::splat(0.5), ks: Rgb::splat(0.5), exponent }));
+    }
+    models.push(("black".into(), Bsdf::Phong { kd: Rgb::ZERO, ks: Rgb::ZERO, exponent: 5.0 }));
+    models.push(("mirror".into(), Bsdf::Mirror { reflectance: Rgb::ONE }));
+    for ior in [1.0, 1.5, 0.7, 2.4] {
+        models.push((format!("dielectric {ior}"), Bsdf::Dielectric { ior }));
+    }
+    for (name, b) in &models {
+        for &co in &cosines {
+            let wo = dir(co, 0.9);
+            for &ci in &cosines {
+                for wi in [dir(ci, 0.9 + std::f32::consts::PI), dir(ci, -0.3), dir(ci, 0.9)] {
+                    let (f, p) = (b.eval(wo, wi), b.pdf(wo, wi));
+                    assert!(f.is_finite() && f.min_element() >= 0.0, "{name}: f({wo}, {wi}) = {f}");
+                    assert!(p.is_finite() && p >= 0.0, "{name}: pdf({wo}, {wi}) = {p}");
+                }
+            }
+            for &ul in &us {
+                for &ux in &us {
+                    for &uy in &us {
+                        if let Some(s) = b.sample(wo, ul, Vec2::new(ux, uy)) {
+                            let ok = s.wi.is_finite() && (s.wi.length() - 1.0).abs() < 1e-3 && s.f.is_finite() && s.pdf.is_finite() && s.pdf > 0.0;
+                            assert!(ok, "{name}: wo = {wo}: {s:?}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn names_parse_and_errors_list_valid_names() {
+    for d in DISTRIBUTIONS {
+        assert_eq!(d.name().parse::<Distribution>(), Ok(d));
+    }
+    for g in GEOMETRIES {
+        assert_eq!(g.name().parse::<Geometry>(), Ok(g));
+    }
+    assert_eq!("ggx".parse(), Ok(Distribution::Ggx));
+    assert_eq!("v-cavity".parse(), Ok(Geometry::VCavity));
+    assert_eq!("GGX".parse::<Distribution>(), Err("unknown microfacet distribution `GGX` (valid: beckmann, ggx)".to_string()));
+    assert_eq!("torrance".parse::<Geometry>(), Err("unknown geometry term `torrance` (valid: smith, v-cavity)".to_string()));
+}
