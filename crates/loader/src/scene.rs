@@ -5,6 +5,8 @@ use std::path::Path;
 
 use raylab_accel::{AccelKind, BuildOptions};
 use raylab_core::{Rgb, Transform, Vec2, Vec3};
+use raylab_render::bsdf::{Distribution, Geometry as MicrofacetGeometry};
+use raylab_render::light::LightSampling;
 use raylab_render::material::TexColor;
 use raylab_render::shape::Sphere;
 use raylab_render::texture::{Checker, CheckerSpace, Filter, ImageTexture, Noise, NoiseKind, Wrap};
@@ -24,18 +26,21 @@ pub struct Overrides {
     pub max_depth: Option<u32>,
     pub sampler: Option<SamplerKind>,
     pub integrator: Option<IntegratorKind>,
+    pub light_sampling: Option<LightSampling>,
     pub accel: Option<AccelKind>,
     pub seed: Option<u64>,
 }
 
 const TOP: &[&str] = &["camera", "render", "background", "textures", "materials", "shapes", "lights"];
 const CAMERA: &[&str] = &["from", "at", "up", "vfov", "width", "height", "aperture", "focus_distance"];
-const RENDER: &[&str] = &["spp", "sampler", "max_depth", "integrator", "accel", "seed"];
+const RENDER: &[&str] = &["spp", "sampler", "max_depth", "integrator", "light_sampling", "accel", "seed"];
 const BACKGROUND: &[&str] = &["color", "texture"];
 const TEXTURE: &[&str] = &["name", "type", "file", "wrap", "filter", "srgb", "scale", "even", "odd", "space", "kind", "colors", "octaves", "seed", "color"];
-const MATERIAL: &[&str] = &["name", "type", "albedo", "ka", "kd", "ks", "exponent", "reflectance", "ior"];
+const MATERIAL: &[&str] = &[
+    "name", "type", "albedo", "ka", "kd", "ks", "exponent", "reflectance", "ior", "diffuse", "specular", "roughness", "distribution", "geometry", "f0",
+];
 const SHAPE: &[&str] = &["type", "material", "transform", "center", "radius", "vertices", "normals", "uvs", "file", "smooth"];
-const LIGHT: &[&str] = &["type", "position", "intensity", "direction", "irradiance"];
+const LIGHT: &[&str] = &["type", "position", "intensity", "direction", "irradiance", "vertices", "radiance", "center", "radius"];
 const TRANSFORM_STEP: &[&str] = &["scale", "rotate", "translate"];
 const ROTATE: &[&str] = &["axis", "degrees"];
 
@@ -69,7 +74,7 @@ pub fn load_scene_str(src: &str, path: &Path, resolver: &Resolver, overrides: &O
         b.shape(&mut scene, &s)?;
     }
     for l in top.tables("lights", LIGHT)? {
-        scene.lights.push(b.light(&l)?);
+        b.light(&mut scene, &l)?;
     }
     scene.build_accel(&BuildOptions::default());
     Ok(scene)
@@ -93,6 +98,14 @@ fn positive(v: &Val, x: f32) -> Result<f32, LoadError> {
 }
 
 fn in_range(v: &Val, x: i64, lo: i64, hi: i64) -> Result<i64, LoadError> {
+    if (lo..=hi).contains(&x) {
+        Ok(x)
+    } else {
+        Err(v.err(format!("must be between {lo} and {hi}, found {x}")))
+    }
+}
+
+fn in_range_f32(v: &Val, x: f32, lo: f32, hi: f32) -> Result<f32, LoadError> {
     if (lo..=hi).contains(&x) {
         Ok(x)
     } else {
@@ -128,6 +141,9 @@ impl Builder<'_> {
             if let Some(v) = r.get("integrator") {
                 s.integrator = v.str()?.parse().map_err(|e: String| v.err(e))?;
             }
+            if let Some(v) = r.get("light_sampling") {
+                s.light_sampling = v.str()?.parse().map_err(|e: String| v.err(e))?;
+            }
             if let Some(v) = r.get("accel") {
                 s.accel = v.str()?.parse().map_err(|e: raylab_accel::UnknownAccel| v.err(e.to_string()))?;
             }
@@ -141,6 +157,7 @@ impl Builder<'_> {
         s.max_depth = o.max_depth.unwrap_or(s.max_depth);
         s.sampler = o.sampler.unwrap_or(s.sampler);
         s.integrator = o.integrator.unwrap_or(s.integrator);
+        s.light_sampling = o.light_sampling.unwrap_or(s.light_sampling);
         s.accel = o.accel.unwrap_or(s.accel);
         s.seed = o.seed.unwrap_or(s.seed);
         if let Err(e) = s.sampler.check_spp(s.spp) {
@@ -266,11 +283,12 @@ impl Builder<'_> {
         if self.material_ids.contains_key(&name) {
             return Err(name_v.err(format!("a material named `{name}` already exists")));
         }
-        let kind = t.type_name(&["diffuse", "phong", "mirror", "dielectric"])?;
+        let kind = t.type_name(&["diffuse", "phong", "mirror", "dielectric", "cooktorrance"])?;
         let valid: &[&str] = match kind {
             "diffuse" => &["albedo"],
             "phong" => &["ka", "kd", "ks", "exponent"],
             "mirror" => &["reflectance"],
+            "cooktorrance" => &["diffuse", "specular", "roughness", "distribution", "geometry", "f0"],
             _ => &["ior"],
         };
         for k in MATERIAL {
@@ -296,6 +314,14 @@ impl Builder<'_> {
                 .unwrap_or(32.0),
             },
             "mirror" => Material::Mirror { reflectance: color("reflectance", Rgb::ONE)? },
+            "cooktorrance" => Material::CookTorrance {
+                diffuse: color("diffuse", Rgb::ZERO)?,
+                specular: color("specular", Rgb::ONE)?,
+                roughness: t.opt("roughness", |v| in_range_f32(v, v.f32()?, 1e-3, 10.0))?.unwrap_or(0.2),
+                distribution: t.opt("distribution", |v| v.str()?.parse::<Distribution>().map_err(|e| v.err(e.to_string())))?.unwrap_or(Distribution::Ggx),
+                geometry: t.opt("geometry", |v| v.str()?.parse::<MicrofacetGeometry>().map_err(|e| v.err(e.to_string())))?.unwrap_or(MicrofacetGeometry::Smith),
+                f0: color("f0", Rgb::splat(0.04))?,
+            },
             _ => Material::Dielectric { ior: t.opt("ior", |v| positive(v, v.f32()?))?.unwrap_or(1.5) },
         };
         let id = scene.add_material(name.clone(), m);
@@ -380,7 +406,7 @@ impl Builder<'_> {
                 let center = t.opt("center", |v| v.vec3())?.unwrap_or(Vec3::ZERO);
                 let rv = t.req("radius")?;
                 let radius = positive(&rv, rv.f32()?)?;
-                scene.geometry.add_sphere(Sphere { center, radius, to_world, material: mat });
+                scene.geometry.add_sphere(Sphere { center, radius, to_world, material: mat, emission: Rgb::ZERO });
             }
             "triangle" | "quad" => {
                 let n = if kind == "triangle" { 3 } else { 4 };
@@ -417,6 +443,9 @@ impl Builder<'_> {
                 let smooth = t.opt("smooth", |v| v.bool())?.unwrap_or(false);
                 let obj = load_obj(&found, &to_world)?;
                 for (mut mesh, mtl) in obj.meshes {
+                    if let Some(ke) = mtl.and_then(|k| obj.materials.get(k)).and_then(|m| m.emissive) {
+                        mesh.emission = mtl_color(Some(ke), Rgb::ZERO);
+                    }
                     mesh.material = match (material, mtl) {
                         (Some(m), _) => m,
                         (None, Some(k)) if k < obj.materials.len() => self.mtl_material(scene, &fv, &obj.materials, k, obj.mtl_dir.as_ref())?,
@@ -463,11 +492,13 @@ impl Builder<'_> {
         Ok(id)
     }
 
-    fn light(&self, t: &Table) -> Result<Light, LoadError> {
-        let kind = t.type_name(&["point", "directional", "ambient"])?;
+    fn light(&mut self, scene: &mut Scene, t: &Table) -> Result<(), LoadError> {
+        let kind = t.type_name(&["point", "directional", "ambient", "rect", "sphere"])?;
         let valid: &[&str] = match kind {
             "point" => &["position", "intensity"],
             "directional" => &["direction", "irradiance"],
+            "rect" => &["vertices", "radiance"],
+            "sphere" => &["center", "radius", "radiance"],
             _ => &["intensity"],
         };
         for k in LIGHT {
@@ -475,15 +506,54 @@ impl Builder<'_> {
                 return Err(t.get(k).unwrap().err(format!("not a field of `{kind}` lights (valid: type, {})", valid.join(", "))));
             }
         }
-        Ok(match kind {
+        let light = match kind {
             "point" => Light::Point { position: t.req("position")?.vec3()?, intensity: t.req("intensity")?.color()? },
             "directional" => {
                 let dv = t.req("direction")?;
                 let direction = dv.vec3()?.try_normalize().ok_or_else(|| dv.err("must not be zero"))?;
                 Light::Directional { direction, irradiance: t.req("irradiance")?.color()? }
             }
-            _ => Light::Ambient { intensity: t.req("intensity")?.color()? },
-        })
+            "ambient" => Light::Ambient { intensity: t.req("intensity")?.color()? },
+            _ => return self.area_light(scene, kind, t),
+        };
+        scene.lights.push(light);
+        Ok(())
+    }
+
+    /// Area lights are geometry that emits and reflects nothing (a black material).
+    fn area_light(&mut self, scene: &mut Scene, kind: &str, t: &Table) -> Result<(), LoadError> {
+        let rv = t.req("radiance")?;
+        let radiance = rv.color()?;
+        if radiance.min_element() < 0.0 {
+            return Err(rv.err(format!("must not be negative, found {radiance}")));
+        }
+        let black = *self.material_ids.entry("<area light>".into()).or_insert_with(|| scene.add_material("<area light>", Material::Diffuse { albedo: TexColor::Constant(Rgb::ZERO) }));
+        if kind == "sphere" {
+            let center = t.req("center")?.vec3()?;
+            let rv = t.req("radius")?;
+            let radius = positive(&rv, rv.f32()?)?;
+            scene.geometry.add_sphere(Sphere { center, radius, to_world: Transform::IDENTITY, material: black, emission: radiance });
+            return Ok(());
+        }
+        let vv = t.req("vertices")?;
+        let verts = vv.points().map_err(|_| vv.err("expected an array of 4 points [x, y, z]"))?;
+        if verts.len() != 4 {
+            return Err(vv.err(format!("expected 4 vertices, found {}", verts.len())));
+        }
+        if (verts[1] - verts[0]).cross(verts[2] - verts[0]).length_squared() == 0.0 {
+            return Err(vv.err("the first three vertices must not be collinear"));
+        }
+        let mesh = TriangleMesh {
+            name: "rect light".into(),
+            positions: verts,
+            indices: vec![[0, 1, 2], [0, 2, 3]],
+            uvs: vec![Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0)],
+            material: black,
+            emission: radiance,
+            ..Default::default()
+        };
+        scene.geometry.add_mesh(mesh);
+        Ok(())
     }
 }
 
@@ -510,6 +580,7 @@ pub fn load_mesh_scene(path: &Path, overrides: &Overrides) -> Result<Scene, Load
     settings.max_depth = overrides.max_depth.unwrap_or(settings.max_depth);
     settings.sampler = overrides.sampler.unwrap_or(settings.sampler);
     settings.integrator = overrides.integrator.unwrap_or(settings.integrator);
+    settings.light_sampling = overrides.light_sampling.unwrap_or(settings.light_sampling);
     settings.accel = overrides.accel.unwrap_or(settings.accel);
     settings.seed = overrides.seed.unwrap_or(settings.seed);
     settings.sampler.check_spp(settings.spp).map_err(|e| LoadError::new(path, None, "--spp", e))?;

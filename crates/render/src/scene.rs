@@ -3,7 +3,7 @@ use raylab_core::{offset_ray_origin, Ray, Rgb, Vec3};
 
 use crate::camera::Camera;
 use crate::integrator::IntegratorKind;
-use crate::light::Light;
+use crate::light::{AreaLights, Light, LightSampling};
 use crate::material::{Material, MaterialId, TextureId};
 use crate::sampler::SamplerKind;
 use crate::shape::{Geometry, SurfaceGeometry};
@@ -28,13 +28,15 @@ pub struct RenderSettings {
     /// Maximum number of path segments from the camera (1 = only what the camera sees).
     pub max_depth: u32,
     pub integrator: IntegratorKind,
+    /// How `direct` and `path` sample area lights.
+    pub light_sampling: LightSampling,
     pub accel: AccelKind,
     pub seed: u64,
 }
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { width: 640, height: 480, spp: 4, sampler: SamplerKind::Jittered, max_depth: 8, integrator: IntegratorKind::Whitted, accel: AccelKind::Bvh, seed: 0 }
+        Self { width: 640, height: 480, spp: 4, sampler: SamplerKind::Jittered, max_depth: 8, integrator: IntegratorKind::Whitted, light_sampling: LightSampling::Mis, accel: AccelKind::Bvh, seed: 0 }
     }
 }
 
@@ -74,6 +76,8 @@ pub struct Scene {
     pub texture_names: Vec<String>,
     pub lights: Vec<Light>,
     pub background: Background,
+    /// The emitting primitives, rebuilt with the acceleration structure.
+    pub area_lights: AreaLights,
     accel: AnyAccel,
 }
 
@@ -92,6 +96,7 @@ impl Scene {
             texture_names: Vec::new(),
             lights: Vec::new(),
             background: Background::Color(Rgb::ZERO),
+            area_lights: AreaLights::default(),
             accel,
         }
     }
@@ -100,6 +105,7 @@ impl Scene {
     /// changes.
     pub fn build_accel(&mut self, opts: &BuildOptions) {
         self.accel = AnyAccel::build(self.settings.accel, &self.geometry, opts);
+        self.area_lights = AreaLights::new(&self.geometry);
     }
 
     pub fn accel(&self) -> &AnyAccel {

@@ -20,7 +20,7 @@ fn scaled_scene(s: f32, width: u32, height: u32) -> Scene {
     let floor = scene.add_material("floor", Material::Diffuse { albedo: TexColor::Constant(Rgb::splat(0.8)) });
     let ball = scene.add_material("ball", Material::Phong { ka: Rgb::ZERO.into(), kd: Rgb::new(0.7, 0.3, 0.2).into(), ks: Rgb::splat(0.3).into(), exponent: 30.0 });
     scene.geometry.add_mesh(TriangleMesh { material: floor, ..quad(s, 0.0, 5.0) });
-    scene.geometry.add_sphere(Sphere { center: Vec3::new(0.0, 0.5, 0.0) * s, radius: 0.5 * s, to_world: raylab_core::Transform::IDENTITY, material: ball });
+    scene.geometry.add_sphere(Sphere { center: Vec3::new(0.0, 0.5, 0.0) * s, radius: 0.5 * s, to_world: raylab_core::Transform::IDENTITY, material: ball, emission: raylab_core::Rgb::ZERO });
     scene.lights.push(Light::Point { position: Vec3::new(1.5, 3.0, 2.0) * s, intensity: Rgb::splat(20.0 * s * s) });
     scene.build_accel(&BuildOptions::default());
     scene

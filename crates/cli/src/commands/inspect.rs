@@ -67,6 +67,7 @@ struct Counts {
     materials: usize,
     textures: usize,
     lights: usize,
+    area_light_primitives: usize,
 }
 
 #[derive(Serialize)]
@@ -120,6 +121,7 @@ fn report(name: String, scene: &Scene) -> Report {
             materials: scene.materials.len(),
             textures: scene.textures.len(),
             lights: scene.lights.len(),
+            area_light_primitives: scene.area_lights.len(),
         },
         meshes: g
             .meshes
@@ -174,8 +176,8 @@ pub fn run(a: &InspectArgs) -> Result<()> {
     println!("render      {}×{}, {} spp ({}), integrator {}, max depth {}, accel {}, seed {}", s.width, s.height, s.spp, s.sampler, s.integrator, s.max_depth, s.accel, s.seed);
     let n = &r.counts;
     println!(
-        "contents    {} shapes: {} meshes ({} triangles), {} spheres; {} materials, {} textures, {} lights",
-        n.shapes, n.meshes, n.triangles, n.spheres, n.materials, n.textures, n.lights
+        "contents    {} shapes: {} meshes ({} triangles), {} spheres; {} materials, {} textures, {} lights, {} emitting primitives",
+        n.shapes, n.meshes, n.triangles, n.spheres, n.materials, n.textures, n.lights, n.area_light_primitives
     );
     println!("bounds      {:?} .. {:?}", r.bounds[0], r.bounds[1]);
     println!("memory      geometry {:.1} KiB, acceleration structure {:.1} KiB", r.geometry_bytes as f64 / 1024.0, r.accel.memory_bytes as f64 / 1024.0);

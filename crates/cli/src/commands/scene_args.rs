@@ -6,6 +6,7 @@ use anyhow::Result;
 use clap::Args;
 use raylab_accel::AccelKind;
 use raylab_loader::Overrides;
+use raylab_render::light::LightSampling;
 use raylab_render::{IntegratorKind, SamplerKind, Scene};
 
 #[derive(Args, Clone, Debug, Default)]
@@ -27,9 +28,12 @@ pub struct SceneArgs {
     /// Maximum number of path segments from the camera
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub max_depth: Option<u32>,
-    /// Integrator: whitted or normals
+    /// Integrator: whitted, direct, path, normals, albedo, depth, heatmap, heatmap-tests
     #[arg(long)]
     pub integrator: Option<String>,
+    /// Area-light sampling of direct and path: uniform, solid-angle, bsdf or mis
+    #[arg(long)]
+    pub light_sampling: Option<String>,
     /// Acceleration structure (none, bvh, ...; see `raylab inspect --help`)
     #[arg(long)]
     pub accel: Option<String>,
@@ -51,6 +55,7 @@ impl SceneArgs {
             max_depth: self.max_depth,
             sampler: self.sampler.as_ref().map(|s| s.parse::<SamplerKind>().map_err(|e| anyhow::anyhow!("--sampler: {e}"))).transpose()?,
             integrator: self.integrator.as_ref().map(|s| s.parse::<IntegratorKind>().map_err(|e| anyhow::anyhow!("--integrator: {e}"))).transpose()?,
+            light_sampling: self.light_sampling.as_ref().map(|s| s.parse::<LightSampling>().map_err(|e| anyhow::anyhow!("--light-sampling: {e}"))).transpose()?,
             accel: self.accel.as_ref().map(parse_accel).transpose()?,
             seed: self.seed,
         })

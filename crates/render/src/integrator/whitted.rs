@@ -5,7 +5,7 @@
 //! by segment `d` needs `d + 1 ≤ max_depth`, and so does a reflected or refracted ray.
 
 use raylab_accel::Counters;
-use raylab_core::{Ray, Rgb, Vec3};
+use raylab_core::{Frame, Ray, Rgb, Vec3};
 
 use crate::light::Light;
 use crate::material::{fresnel_dielectric, reflect, refract, Material};
@@ -16,13 +16,14 @@ pub(super) fn radiance(scene: &Scene, ray: &Ray, depth: u32, c: &mut Counters) -
     let Some(hit) = scene.intersect(ray, c) else {
         return scene.background(ray.dir);
     };
-    if depth + 1 > scene.settings.max_depth {
-        return Rgb::ZERO;
-    }
     let wo = -ray.dir.normalize();
     let g = &hit.geom;
+    let le = scene.geometry.emitted(hit.prim, g, wo);
+    if depth + 1 > scene.settings.max_depth {
+        return le;
+    }
     let tex = &scene.textures;
-    match &scene.materials[hit.material.0 as usize] {
+    le + match &scene.materials[hit.material.0 as usize] {
         Material::Diffuse { albedo } => {
             let kd = albedo.eval(tex, g.uv, g.p) * std::f32::consts::FRAC_1_PI;
             direct(scene, &hit, wo, c, |_wi, _n| kd)
@@ -38,6 +39,13 @@ pub(super) fn radiance(scene: &Scene, ray: &Ray, depth: u32, c: &mut Counters) -
                     let spec = reflect(wi, n).dot(wo).max(0.0).powf(*exponent);
                     kd + ks * (spec / cos)
                 })
+        }
+        m @ Material::CookTorrance { .. } => {
+            // Microfacet reflection of the delta lights, by the physically based BSDF.
+            let bsdf = m.bsdf(tex, g.uv, g.p);
+            let frame = Frame::from_z(facing(g.ns, wo));
+            let wo_local = frame.to_local(wo);
+            direct(scene, &hit, wo, c, |wi, _n| bsdf.eval(wo_local, frame.to_local(wi)))
         }
         Material::Mirror { reflectance } => {
             let n = facing(g.ns, wo);

@@ -1,5 +1,9 @@
-//! Lights of the Whitted model: point and directional lights (delta lights, invisible to
-//! camera rays) and a constant ambient term.
+//! Delta lights (point and directional, invisible to camera rays), the Phong model's constant
+//! ambient term, and area lights (`area.rs`): emitting geometry.
+
+mod area;
+
+pub use area::{AreaLights, AreaSample, LightSampling};
 
 use raylab_core::{Rgb, Vec3};
 

@@ -7,6 +7,7 @@ pub use fresnel::{fresnel_dielectric, reflect, refract};
 
 use raylab_core::{Rgb, Vec2, Vec3};
 
+use crate::bsdf::{Bsdf, Distribution, Geometry as MicrofacetGeometry};
 use crate::texture::Texture;
 
 /// Index of a material in [`crate::Scene::materials`]; 0 is the default grey diffuse.
@@ -52,9 +53,39 @@ pub enum Material {
     /// Smooth dielectric (glass, water): Snell refraction weighted by the exact unpolarised
     /// Fresnel term; total internal reflection. `ior` is inside over outside (outside = 1).
     Dielectric { ior: f32 },
+    /// Cook–Torrance microfacet reflection over a Lambertian base (see `crate::bsdf`):
+    /// `f = diffuse/π + specular·D·G·F / (4 cos θi cos θo)`, `roughness` = α.
+    CookTorrance { diffuse: TexColor, specular: TexColor, roughness: f32, distribution: Distribution, geometry: MicrofacetGeometry, f0: TexColor },
 }
 
 impl Material {
+    /// The physically based BSDF at a surface point (textures looked up at `uv`, `p`). The
+    /// Phong material becomes the energy-normalised Phong lobe; `ka` has no place in it.
+    pub fn bsdf(&self, textures: &[Texture], uv: Vec2, p: Vec3) -> Bsdf {
+        let c = |t: &TexColor| t.eval(textures, uv, p);
+        match self {
+            Material::Diffuse { albedo } => Bsdf::Lambert { albedo: c(albedo) },
+            Material::Phong { kd, ks, exponent, .. } => Bsdf::Phong { kd: c(kd), ks: c(ks), exponent: *exponent },
+            Material::Mirror { reflectance } => Bsdf::Mirror { reflectance: c(reflectance) },
+            Material::Dielectric { ior } => Bsdf::Dielectric { ior: *ior },
+            Material::CookTorrance { diffuse, specular, roughness, distribution, geometry, f0 } => {
+                Bsdf::CookTorrance { diffuse: c(diffuse), specular: c(specular), alpha: *roughness, distribution: *distribution, geometry: *geometry, f0: c(f0) }
+            }
+        }
+    }
+
+    /// The diffuse colour (the `albedo` AOV).
+    pub fn albedo(&self, textures: &[Texture], uv: Vec2, p: Vec3) -> Rgb {
+        let c = |t: &TexColor| t.eval(textures, uv, p);
+        match self {
+            Material::Diffuse { albedo } => c(albedo),
+            Material::Phong { kd, .. } => c(kd),
+            Material::Mirror { reflectance } => c(reflectance),
+            Material::Dielectric { .. } => Rgb::ONE,
+            Material::CookTorrance { diffuse, specular, .. } => c(diffuse) + c(specular),
+        }
+    }
+
     pub fn default_diffuse() -> Self {
         Material::Diffuse { albedo: TexColor::Constant(Rgb::splat(0.5)) }
     }
@@ -65,6 +96,7 @@ impl Material {
             Material::Phong { .. } => "phong",
             Material::Mirror { .. } => "mirror",
             Material::Dielectric { .. } => "dielectric",
+            Material::CookTorrance { .. } => "cooktorrance",
         }
     }
 }

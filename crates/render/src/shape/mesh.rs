@@ -1,4 +1,4 @@
-use raylab_core::{intersect, Aabb, Ray, Vec2, Vec3};
+use raylab_core::{intersect, Aabb, Ray, Rgb, Vec2, Vec3};
 
 use super::SurfaceGeometry;
 use crate::material::MaterialId;
@@ -15,6 +15,9 @@ pub struct TriangleMesh {
     pub uvs: Vec<Vec2>,
     pub indices: Vec<[u32; 3]>,
     pub material: MaterialId,
+    /// Radiance emitted on the side of the winding normal `(p1 - p0) × (p2 - p0)`, zero for
+    /// surfaces that do not emit (pbrt's one-sided diffuse area light).
+    pub emission: Rgb,
 }
 
 impl TriangleMesh {
@@ -30,6 +33,18 @@ impl TriangleMesh {
     pub fn vertices(&self, tri: u32) -> [Vec3; 3] {
         let [a, b, c] = self.indices[tri as usize];
         [self.positions[a as usize], self.positions[b as usize], self.positions[c as usize]]
+    }
+
+    /// Unit normal of the triangle's winding order, `(p1 - p0) × (p2 - p0)`: the side an
+    /// emitting triangle lights.
+    pub fn winding_normal(&self, tri: u32) -> Vec3 {
+        let [a, b, c] = self.vertices(tri);
+        (b - a).cross(c - a).try_normalize().unwrap_or(Vec3::Y)
+    }
+
+    pub fn area(&self, tri: u32) -> f32 {
+        let [a, b, c] = self.vertices(tri);
+        0.5 * (b - a).cross(c - a).length()
     }
 
     pub fn triangle_bounds(&self, tri: u32) -> Aabb {

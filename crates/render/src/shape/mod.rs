@@ -10,7 +10,7 @@ pub use mesh::TriangleMesh;
 pub use sphere::Sphere;
 
 use raylab_accel::{PrimHit, Primitives};
-use raylab_core::{Aabb, Ray, Vec2, Vec3};
+use raylab_core::{Aabb, Ray, Rgb, Vec2, Vec3};
 
 use crate::material::MaterialId;
 
@@ -85,6 +85,28 @@ impl Geometry {
             PrimRef::Triangle { mesh, tri } => self.meshes[mesh as usize].surface(tri, u, v),
             PrimRef::Sphere(s) => self.spheres[s as usize].surface(ray, t),
         }
+    }
+
+    /// Radiance the primitive emits (zero for most).
+    pub fn emission(&self, prim: u32) -> Rgb {
+        match self.prims[prim as usize] {
+            PrimRef::Triangle { mesh, .. } => self.meshes[mesh as usize].emission,
+            PrimRef::Sphere(s) => self.spheres[s as usize].emission,
+        }
+    }
+
+    /// Radiance leaving point `geom` of primitive `prim` in direction `w`: emitters are
+    /// one-sided (triangles along their winding normal, spheres outwards).
+    pub fn emitted(&self, prim: u32, geom: &SurfaceGeometry, w: Vec3) -> Rgb {
+        let le = self.emission(prim);
+        if le == Rgb::ZERO {
+            return le;
+        }
+        let n = match self.prims[prim as usize] {
+            PrimRef::Triangle { mesh, tri } => self.meshes[mesh as usize].winding_normal(tri),
+            PrimRef::Sphere(_) => geom.ng,
+        };
+        if n.dot(w) > 0.0 { le } else { Rgb::ZERO }
     }
 
     pub fn total_bounds(&self) -> Aabb {

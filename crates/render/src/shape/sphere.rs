@@ -1,4 +1,4 @@
-use raylab_core::{intersect, Aabb, Ray, Transform, Vec2, Vec3};
+use raylab_core::{intersect, Aabb, Ray, Rgb, Transform, Vec2, Vec3};
 use std::f32::consts::PI;
 
 use super::SurfaceGeometry;
@@ -12,6 +12,8 @@ pub struct Sphere {
     pub radius: f32,
     pub to_world: Transform,
     pub material: MaterialId,
+    /// Radiance emitted outwards, zero for spheres that do not emit.
+    pub emission: Rgb,
 }
 
 impl Sphere {

@@ -1,0 +1,161 @@
+//! Monte Carlo light transport: `path` (unidirectional path tracing with next-event
+//! estimation, multiple importance sampling and Russian roulette, as in pbrt-v4's
+//! `PathIntegrator`) and `direct` (the same path cut after the first non-specular bounce).
+//!
+//! `max_depth` counts path segments from the camera: 1 shows only emitters seen directly,
+//! 2 adds direct lighting, and so on. Delta lights (point, directional) are always sampled;
+//! area lights by the scene's `light_sampling` strategy; the background is radiance from
+//! infinity found by BSDF sampling.
+
+use raylab_accel::Counters;
+use raylab_core::{Frame, Ray, Rgb, Vec3};
+
+use crate::bsdf::Bsdf;
+use crate::light::{Light, LightSampling};
+use crate::sampler::PixelSampler;
+use crate::scene::SurfaceHit;
+use crate::Scene;
+
+/// Power heuristic with β = 2 (Veach 1997): the weight of a sample drawn with density
+/// `f` when `g` is the density of the other strategy.
+fn power_heuristic(f: f32, g: f32) -> f32 {
+    let (f2, g2) = (f * f, g * g);
+    if f2.is_infinite() {
+        return 1.0;
+    }
+    if f2 + g2 == 0.0 {
+        0.0
+    } else {
+        f2 / (f2 + g2)
+    }
+}
+
+/// The shading frame at a hit: for opaque BSDFs the shading normal turned towards `wo`
+/// (two-sided surfaces); for dielectrics oriented like the geometric normal, so that the
+/// local `wo.z < 0` means "inside".
+fn shading_frame(hit: &SurfaceHit, bsdf: &Bsdf, wo: Vec3) -> Frame {
+    let g = &hit.geom;
+    let n = match bsdf {
+        Bsdf::Dielectric { .. } => {
+            if g.ns.dot(g.ng) < 0.0 {
+                -g.ns
+            } else {
+                g.ns
+            }
+        }
+        _ => {
+            if g.ns.dot(wo) < 0.0 {
+                -g.ns
+            } else {
+                g.ns
+            }
+        }
+    };
+    Frame::from_z(n)
+}
+
+pub(super) fn radiance(scene: &Scene, camera_ray: &Ray, sampler: &mut PixelSampler, c: &mut Counters, direct_only: bool) -> Rgb {
+    let s = &scene.settings;
+    let strategy = s.light_sampling;
+    let mut l = Rgb::ZERO;
+    let mut beta = Rgb::ONE;
+    let mut ray = *camera_ray;
+    // What the previous bounce knows for weighting emission found by BSDF sampling.
+    let mut specular = true;
+    let mut prev_pdf = 0.0f32;
+    let mut prev_p = ray.origin;
+    for depth in 1..=s.max_depth {
+        let Some(hit) = scene.intersect(&ray, c) else {
+            l += beta * scene.background(ray.dir);
+            break;
+        };
+        let wo = -ray.dir.normalize();
+        let le = scene.geometry.emitted(hit.prim, &hit.geom, wo);
+        if le != Rgb::ZERO {
+            let weight = if specular || strategy == LightSampling::Bsdf {
+                1.0
+            } else if strategy == LightSampling::Mis {
+                let light_pdf = scene.area_lights.pdf(&scene.geometry, strategy, hit.prim, prev_p, hit.geom.p, hit.geom.ng);
+                power_heuristic(prev_pdf, light_pdf)
+            } else {
+                0.0 // counted by light sampling at the previous vertex
+            };
+            l += beta * le * weight;
+        }
+        if depth == s.max_depth || (direct_only && !specular && depth > 1) {
+            break;
+        }
+        let material = &scene.materials[hit.material.0 as usize];
+        let bsdf = material.bsdf(&scene.textures, hit.geom.uv, hit.geom.p);
+        let frame = shading_frame(&hit, &bsdf, wo);
+        let wo_local = frame.to_local(wo);
+        if !bsdf.is_delta() {
+            l += beta * direct_light(scene, &hit, &bsdf, &frame, wo, sampler, c);
+        }
+        let Some(bs) = bsdf.sample(wo_local, sampler.get_1d(), sampler.get_2d()) else { break };
+        if bs.pdf <= 0.0 || bs.f == Rgb::ZERO {
+            break;
+        }
+        let wi = frame.to_world(bs.wi);
+        // Reflection must stay on `wo`'s side of the real surface, transmission cross it:
+        // otherwise interpolated normals would let light through.
+        let reflect = bs.wi.z * wo_local.z > 0.0;
+        if reflect != (wi.dot(hit.geom.ng) * wo.dot(hit.geom.ng) > 0.0) {
+            break;
+        }
+        beta *= bs.f * bs.wi.z.abs() / bs.pdf;
+        specular = bs.delta;
+        prev_pdf = bs.pdf;
+        prev_p = hit.geom.p;
+        ray = hit.spawn(wi);
+        // Russian roulette after three bounces (pbrt-v4): unbiased, bounded weights.
+        if depth >= 3 {
+            let q = (1.0 - beta.max_element()).max(0.05);
+            if sampler.get_1d() < q {
+                break;
+            }
+            beta /= 1.0 - q;
+        }
+    }
+    l
+}
+
+/// Direct light at a non-specular hit: every delta light, plus one area-light sample and,
+/// for MIS, the BSDF sample's share is added when that path hits the emitter.
+fn direct_light(scene: &Scene, hit: &SurfaceHit, bsdf: &Bsdf, frame: &Frame, wo: Vec3, sampler: &mut PixelSampler, c: &mut Counters) -> Rgb {
+    let wo_local = frame.to_local(wo);
+    let ng = hit.geom.ng;
+    let same_side = |wi: Vec3| wi.dot(ng) * wo.dot(ng) > 0.0 || matches!(bsdf, Bsdf::Dielectric { .. });
+    let mut l = Rgb::ZERO;
+    for light in &scene.lights {
+        if matches!(light, Light::Ambient { .. }) {
+            continue;
+        }
+        let Some(ls) = light.sample(hit.geom.p) else { continue };
+        if !same_side(ls.wi) {
+            continue;
+        }
+        let wi_local = frame.to_local(ls.wi);
+        let f = bsdf.eval(wo_local, wi_local);
+        if f == Rgb::ZERO || scene.occluded(&hit.spawn_to(ls.wi, ls.dist), c) {
+            continue;
+        }
+        l += f * ls.irradiance * wi_local.z.abs();
+    }
+    let strategy = scene.settings.light_sampling;
+    let (u_choice, u) = (sampler.get_1d(), sampler.get_2d());
+    if scene.area_lights.is_empty() || !strategy.samples_lights() {
+        return l;
+    }
+    let Some(ls) = scene.area_lights.sample(&scene.geometry, hit.geom.p, strategy, u_choice, u) else { return l };
+    if ls.pdf <= 0.0 || !same_side(ls.wi) {
+        return l;
+    }
+    let wi_local = frame.to_local(ls.wi);
+    let f = bsdf.eval(wo_local, wi_local);
+    if f == Rgb::ZERO || scene.occluded(&hit.spawn_to(ls.wi, ls.dist), c) {
+        return l;
+    }
+    let weight = if strategy == LightSampling::Mis { power_heuristic(ls.pdf, bsdf.pdf(wo_local, wi_local)) } else { 1.0 };
+    l + f * ls.le * (wi_local.z.abs() * weight / ls.pdf)
+}

@@ -1,0 +1,93 @@
+//! Monte Carlo light transport against closed forms: every light-sampling strategy must
+//! converge to the same, known radiance (seeded, so the estimates are deterministic).
+
+use raylab_accel::BuildOptions;
+use raylab_core::{Rgb, Transform, Vec3};
+use raylab_render::light::LightSampling;
+use raylab_render::material::TexColor;
+use raylab_render::{render, Camera, IntegratorKind, Material, RenderSettings, SamplerKind, Scene, Sphere, TriangleMesh};
+
+fn floor(material: raylab_render::MaterialId, half: f32) -> TriangleMesh {
+    let v = |x: f32, z: f32| Vec3::new(x, 0.0, z);
+    // Wound so that the normal points up (+y).
+    TriangleMesh { name: "floor".into(), positions: vec![v(-half, -half), v(-half, half), v(half, half), v(half, -half)], indices: vec![[0, 1, 2], [0, 2, 3]], material, ..Default::default() }
+}
+
+fn mean(pixels: &[Rgb]) -> f32 {
+    pixels.iter().map(|p| p.y).sum::<f32>() / pixels.len() as f32
+}
+
+/// A Lambertian floor (ρ = 0.5) seen straight down through a 1° camera, under a sphere light
+/// of radius r = 0.5 and radiance Le = 4 centred at height d = 2 (the camera sits below it).
+/// Irradiance facing a sphere light is E = π Le (r/d)², so L = ρ/π · E = ρ Le (r/d)² = 0.125.
+fn sphere_light_scene(strategy: LightSampling, integrator: IntegratorKind) -> Scene {
+    let camera = Camera::new(Vec3::new(0.0, 1.0, 0.0), Vec3::ZERO, Vec3::Z, 1.0, 1.0, 0.0, None).unwrap();
+    let settings = RenderSettings { width: 8, height: 8, spp: 256, sampler: SamplerKind::Sobol, integrator, light_sampling: strategy, max_depth: 2, ..Default::default() };
+    let mut scene = Scene::new(camera, settings);
+    let m = scene.add_material("floor", Material::Diffuse { albedo: TexColor::Constant(Rgb::splat(0.5)) });
+    let black = scene.add_material("light", Material::Diffuse { albedo: TexColor::Constant(Rgb::ZERO) });
+    scene.geometry.add_mesh(floor(m, 50.0));
+    scene.geometry.add_sphere(Sphere { center: Vec3::new(0.0, 2.0, 0.0), radius: 0.5, to_world: Transform::IDENTITY, material: black, emission: Rgb::splat(4.0) });
+    scene.build_accel(&BuildOptions::default());
+    scene
+}
+
+#[test]
+fn every_strategy_converges_to_the_sphere_light_closed_form() {
+    for (strategy, tolerance) in [(LightSampling::Uniform, 0.03), (LightSampling::SolidAngle, 0.01), (LightSampling::Mis, 0.01), (LightSampling::Bsdf, 0.08)] {
+        for integrator in [IntegratorKind::Direct, IntegratorKind::Path] {
+            let img = render(&sphere_light_scene(strategy, integrator), &|_| {});
+            let l = mean(&img.pixels);
+            assert!((l - 0.125).abs() < 0.125 * tolerance, "{strategy} {integrator}: {l} (expected 0.125)");
+        }
+    }
+}
+
+#[test]
+fn solid_angle_sampling_has_less_variance_than_area_sampling() {
+    // Per-pixel spread of the estimates: cone sampling never wastes a sample on the far
+    // half of the sphere, area sampling does.
+    let spread = |s| {
+        let img = render(&sphere_light_scene(s, IntegratorKind::Direct), &|_| {});
+        let m = mean(&img.pixels);
+        img.pixels.iter().map(|p| (p.y - m).powi(2)).sum::<f32>() / img.pixels.len() as f32
+    };
+    let (area, cone) = (spread(LightSampling::Uniform), spread(LightSampling::SolidAngle));
+    assert!(cone < 0.5 * area, "cone {cone}, area {area}");
+}
+
+#[test]
+fn max_depth_one_sees_only_emitters() {
+    // Looking up at the sphere light from below: depth 1 shows its radiance, nothing else.
+    let camera = Camera::new(Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 2.0, 0.0), Vec3::Z, 1.0, 1.0, 0.0, None).unwrap();
+    let mut scene = sphere_light_scene(LightSampling::Mis, IntegratorKind::Path);
+    scene.camera = camera;
+    scene.settings.max_depth = 1;
+    let img = render(&scene, &|_| {});
+    assert!(img.pixels.iter().all(|p| *p == Rgb::splat(4.0)), "{:?}", img.pixels[0]);
+}
+
+/// A closed box, every face emitting Le = 1 inwards and reflecting with albedo ρ: the
+/// radiance everywhere is Le / (1 - ρ) (the "furnace"). Tests the path tracer's
+/// throughput, Russian roulette and MIS over many bounces.
+#[test]
+fn path_tracer_passes_the_emitting_furnace() {
+    let rho = 0.5;
+    let camera = Camera::new(Vec3::ZERO, Vec3::new(0.3, 0.2, 1.0), Vec3::Y, 60.0, 1.0, 0.0, None).unwrap();
+    let settings = RenderSettings { width: 8, height: 8, spp: 64, sampler: SamplerKind::Sobol, integrator: IntegratorKind::Path, max_depth: 200, ..Default::default() };
+    let mut scene = Scene::new(camera, settings);
+    let m = scene.add_material("wall", Material::Diffuse { albedo: TexColor::Constant(Rgb::splat(rho)) });
+    let c = |i: u32| Vec3::new(if i & 1 == 0 { -1.0 } else { 1.0 }, if i & 2 == 0 { -1.0 } else { 1.0 }, if i & 4 == 0 { -1.0 } else { 1.0 });
+    // Faces wound so that their normals point into the box.
+    let faces = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]];
+    let mut mesh = TriangleMesh { name: "box".into(), positions: (0..8).map(c).collect(), material: m, emission: Rgb::ONE, ..Default::default() };
+    for f in faces {
+        mesh.indices.push([f[0], f[1], f[2]]);
+        mesh.indices.push([f[0], f[2], f[3]]);
+    }
+    scene.geometry.add_mesh(mesh);
+    scene.build_accel(&BuildOptions::default());
+    let l = mean(&render(&scene, &|_| {}).pixels);
+    let expected = 1.0 / (1.0 - rho);
+    assert!((l - expected).abs() < 0.03 * expected, "{l} (expected {expected})");
+}
