@@ -25,6 +25,8 @@ enum Command {
     Bench(commands::bench::BenchArgs),
     /// Trace a ray file through a scene or mesh
     Trace(commands::trace::TraceArgs),
+    /// Compare two images: MSE, RMSE, relative MSE, and a false-colour difference image
+    Compare(commands::compare::CompareArgs),
     /// Write a procedural test scene of any size (Haines' Standard Procedural Databases)
     Gen(commands::gen::GenArgs),
 }
@@ -38,6 +40,7 @@ fn main() -> ExitCode {
         Some(Command::Gen(a)) => commands::gen::run(&a),
         Some(Command::Bench(a)) => commands::bench::run(&a),
         Some(Command::Trace(a)) => commands::trace::run(&a),
+        Some(Command::Compare(a)) => commands::compare::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

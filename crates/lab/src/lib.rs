@@ -2,6 +2,7 @@
 //! measured tracing checked against an oracle, the binary ray-file format, and reports.
 
 pub mod bench;
+pub mod compare;
 pub mod rayfile;
 pub mod report;
 pub mod rays;

@@ -1,4 +1,5 @@
 pub mod bench;
+pub mod compare;
 pub mod gen;
 pub mod inspect;
 pub mod render;
