@@ -104,7 +104,8 @@ fn non_utf8_and_syntax_errors_in_the_scene() {
 fn example_scenes_and_default_scene_parse() {
     let scenes = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
     let mut n = 0;
-    for entry in std::fs::read_dir(&scenes).unwrap() {
+    let files = std::fs::read_dir(&scenes).unwrap().chain(std::fs::read_dir(scenes.join("lab")).unwrap());
+    for entry in files {
         let p = entry.unwrap().path();
         if p.extension().is_some_and(|e| e == "toml") {
             let scene = load_scene(&p, &Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
@@ -112,7 +113,7 @@ fn example_scenes_and_default_scene_parse() {
             n += 1;
         }
     }
-    assert!(n >= 10, "only {n} example scenes");
+    assert!(n >= 15, "only {n} example scenes");
     let d = raylab_loader::default_scene(&Overrides::default()).unwrap();
     assert_eq!(d.geometry.triangle_count(), 4968 + 2);
     assert_eq!(d.geometry.spheres.len(), 2);
