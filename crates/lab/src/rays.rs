@@ -8,6 +8,7 @@ use std::str::FromStr;
 use rayon::prelude::*;
 use raylab_accel::Counters;
 use raylab_core::{sampling, Frame, Pcg32, Ray, Vec2};
+use raylab_render::light::LightSampling;
 use raylab_render::{Light, Scene};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -76,11 +77,19 @@ pub fn generate(scene: &Scene, width: u32, height: u32, kinds: &[RayKind], seed:
             let n = if hit.geom.ng.dot(wo) < 0.0 { -hit.geom.ng } else { hit.geom.ng };
             let d = Frame::from_z(n).to_world(sampling::cosine_hemisphere(rng.next_vec2()));
             let diffuse = hit.spawn(d);
-            let shadow = if lights.is_empty() {
-                None
-            } else {
-                let light = lights[rng.below(lights.len() as u32) as usize];
-                light.sample(hit.geom.p).map(|s| hit.spawn_to(s.wi, s.dist.min(1e30)))
+            // One light, chosen uniformly among the delta lights and (as one) the area lights.
+            let area = usize::from(!scene.area_lights.is_empty());
+            let shadow = match rng.below((lights.len() + area).max(1) as u32) as usize {
+                _ if lights.len() + area == 0 => None,
+                k if k < lights.len() => {
+                    let light = lights[k];
+                    let (cell, u) = if light.is_jittered() { (rng.below(light.sample_count()), rng.next_vec2()) } else { (0, Vec2::ZERO) };
+                    light.sample(hit.geom.p, cell, u).map(|s| hit.spawn_to(s.wi, s.dist.min(1e30)))
+                }
+                _ => scene
+                    .area_lights
+                    .sample(&scene.geometry, hit.geom.p, LightSampling::Uniform, rng.next_f32(), rng.next_vec2())
+                    .map(|s| hit.spawn_to(s.wi, s.dist)),
             };
             (Some(diffuse), shadow)
         })

@@ -40,7 +40,7 @@ const MATERIAL: &[&str] = &[
     "name", "type", "albedo", "ka", "kd", "ks", "exponent", "reflectance", "ior", "diffuse", "specular", "roughness", "distribution", "geometry", "f0",
 ];
 const SHAPE: &[&str] = &["type", "material", "transform", "center", "radius", "vertices", "normals", "uvs", "file", "smooth"];
-const LIGHT: &[&str] = &["type", "position", "intensity", "direction", "irradiance", "vertices", "radiance", "center", "radius"];
+const LIGHT: &[&str] = &["type", "position", "intensity", "direction", "irradiance", "vertices", "radiance", "center", "radius", "n"];
 const TRANSFORM_STEP: &[&str] = &["scale", "rotate", "translate"];
 const ROTATE: &[&str] = &["axis", "degrees"];
 
@@ -493,10 +493,11 @@ impl Builder<'_> {
     }
 
     fn light(&mut self, scene: &mut Scene, t: &Table) -> Result<(), LoadError> {
-        let kind = t.type_name(&["point", "directional", "ambient", "rect", "sphere"])?;
+        let kind = t.type_name(&["point", "directional", "ambient", "grid", "rect", "sphere"])?;
         let valid: &[&str] = match kind {
             "point" => &["position", "intensity"],
             "directional" => &["direction", "irradiance"],
+            "grid" => &["vertices", "n", "intensity"],
             "rect" => &["vertices", "radiance"],
             "sphere" => &["center", "radius", "radiance"],
             _ => &["intensity"],
@@ -514,10 +515,35 @@ impl Builder<'_> {
                 Light::Directional { direction, irradiance: t.req("irradiance")?.color()? }
             }
             "ambient" => Light::Ambient { intensity: t.req("intensity")?.color()? },
+            "grid" => {
+                let [corner, edge_u, edge_v] = self.parallelogram(t)?;
+                let nv = t.req("n")?;
+                let n = in_range(&nv, nv.integer()?, 1, 64)? as u32;
+                Light::Grid { corner, edge_u, edge_v, n, intensity: t.req("intensity")?.color()? }
+            }
             _ => return self.area_light(scene, kind, t),
         };
         scene.lights.push(light);
         Ok(())
+    }
+
+    /// The 4 `vertices` of a light, in order around the boundary, not collinear.
+    fn quad_vertices(&self, t: &Table) -> Result<Vec<Vec3>, LoadError> {
+        let vv = t.req("vertices")?;
+        let verts = vv.points().map_err(|_| vv.err("expected an array of 4 points [x, y, z]"))?;
+        if verts.len() != 4 {
+            return Err(vv.err(format!("expected 4 vertices, found {}", verts.len())));
+        }
+        if (verts[1] - verts[0]).cross(verts[2] - verts[0]).length_squared() == 0.0 {
+            return Err(vv.err("the first three vertices must not be collinear"));
+        }
+        Ok(verts)
+    }
+
+    /// Corner and edges of the parallelogram spanned by `vertices` 0, 1 and 3.
+    fn parallelogram(&self, t: &Table) -> Result<[Vec3; 3], LoadError> {
+        let v = self.quad_vertices(t)?;
+        Ok([v[0], v[1] - v[0], v[3] - v[0]])
     }
 
     /// Area lights are geometry that emits and reflects nothing (a black material).
@@ -535,14 +561,7 @@ impl Builder<'_> {
             scene.geometry.add_sphere(Sphere { center, radius, to_world: Transform::IDENTITY, material: black, emission: radiance });
             return Ok(());
         }
-        let vv = t.req("vertices")?;
-        let verts = vv.points().map_err(|_| vv.err("expected an array of 4 points [x, y, z]"))?;
-        if verts.len() != 4 {
-            return Err(vv.err(format!("expected 4 vertices, found {}", verts.len())));
-        }
-        if (verts[1] - verts[0]).cross(verts[2] - verts[0]).length_squared() == 0.0 {
-            return Err(vv.err("the first three vertices must not be collinear"));
-        }
+        let verts = self.quad_vertices(t)?;
         let mesh = TriangleMesh {
             name: "rect light".into(),
             positions: verts,

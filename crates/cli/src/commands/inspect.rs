@@ -157,6 +157,7 @@ fn describe_light(l: &Light) -> String {
         Light::Point { position: p, intensity: i } => format!("point at [{}, {}, {}], intensity [{}, {}, {}] W/sr", p.x, p.y, p.z, i.x, i.y, i.z),
         Light::Directional { direction: d, irradiance: e } => format!("directional along [{:.3}, {:.3}, {:.3}], irradiance [{}, {}, {}]", d.x, d.y, d.z, e.x, e.y, e.z),
         Light::Ambient { intensity: i } => format!("ambient [{}, {}, {}]", i.x, i.y, i.z),
+        Light::Grid { corner: c, n, intensity: i, .. } => format!("grid of {n}×{n} jittered point lights from [{}, {}, {}], total intensity [{}, {}, {}] W/sr", c.x, c.y, c.z, i.x, i.y, i.z),
     }
 }
 

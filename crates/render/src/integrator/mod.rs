@@ -72,7 +72,7 @@ impl IntegratorKind {
     /// Radiance arriving along `ray` (a camera ray).
     pub fn radiance(self, scene: &Scene, ray: &Ray, sampler: &mut PixelSampler, counters: &mut Counters) -> Rgb {
         match self {
-            IntegratorKind::Whitted => whitted::radiance(scene, ray, 1, counters),
+            IntegratorKind::Whitted => whitted::radiance(scene, ray, 1, sampler, counters),
             IntegratorKind::Direct => path::radiance(scene, ray, sampler, counters, true),
             IntegratorKind::Path => path::radiance(scene, ray, sampler, counters, false),
             IntegratorKind::Albedo => match scene.intersect(ray, counters) {

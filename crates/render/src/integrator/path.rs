@@ -8,10 +8,10 @@
 //! infinity found by BSDF sampling.
 
 use raylab_accel::Counters;
-use raylab_core::{Frame, Ray, Rgb, Vec3};
+use raylab_core::{Frame, Ray, Rgb, Vec2, Vec3};
 
 use crate::bsdf::Bsdf;
-use crate::light::{Light, LightSampling};
+use crate::light::LightSampling;
 use crate::sampler::PixelSampler;
 use crate::scene::SurfaceHit;
 use crate::Scene;
@@ -128,19 +128,19 @@ fn direct_light(scene: &Scene, hit: &SurfaceHit, bsdf: &Bsdf, frame: &Frame, wo:
     let same_side = |wi: Vec3| wi.dot(ng) * wo.dot(ng) > 0.0 || matches!(bsdf, Bsdf::Dielectric { .. });
     let mut l = Rgb::ZERO;
     for light in &scene.lights {
-        if matches!(light, Light::Ambient { .. }) {
-            continue;
+        for k in 0..light.sample_count() {
+            let u = if light.is_jittered() { sampler.get_2d() } else { Vec2::ZERO };
+            let Some(ls) = light.sample(hit.geom.p, k, u) else { continue };
+            if !same_side(ls.wi) {
+                continue;
+            }
+            let wi_local = frame.to_local(ls.wi);
+            let f = bsdf.eval(wo_local, wi_local);
+            if f == Rgb::ZERO || scene.occluded(&hit.spawn_to(ls.wi, ls.dist), c) {
+                continue;
+            }
+            l += f * ls.irradiance * wi_local.z.abs();
         }
-        let Some(ls) = light.sample(hit.geom.p) else { continue };
-        if !same_side(ls.wi) {
-            continue;
-        }
-        let wi_local = frame.to_local(ls.wi);
-        let f = bsdf.eval(wo_local, wi_local);
-        if f == Rgb::ZERO || scene.occluded(&hit.spawn_to(ls.wi, ls.dist), c) {
-            continue;
-        }
-        l += f * ls.irradiance * wi_local.z.abs();
     }
     let strategy = scene.settings.light_sampling;
     let (u_choice, u) = (sampler.get_1d(), sampler.get_2d());

@@ -5,14 +5,16 @@
 //! by segment `d` needs `d + 1 ≤ max_depth`, and so does a reflected or refracted ray.
 
 use raylab_accel::Counters;
-use raylab_core::{Frame, Ray, Rgb, Vec3};
+use raylab_core::{Frame, Ray, Rgb, Vec2, Vec3};
+
+use crate::sampler::PixelSampler;
 
 use crate::light::Light;
 use crate::material::{fresnel_dielectric, reflect, refract, Material};
 use crate::scene::SurfaceHit;
 use crate::Scene;
 
-pub(super) fn radiance(scene: &Scene, ray: &Ray, depth: u32, c: &mut Counters) -> Rgb {
+pub(super) fn radiance(scene: &Scene, ray: &Ray, depth: u32, sampler: &mut PixelSampler, c: &mut Counters) -> Rgb {
     let Some(hit) = scene.intersect(ray, c) else {
         return scene.background(ray.dir);
     };
@@ -26,7 +28,7 @@ pub(super) fn radiance(scene: &Scene, ray: &Ray, depth: u32, c: &mut Counters) -
     le + match &scene.materials[hit.material.0 as usize] {
         Material::Diffuse { albedo } => {
             let kd = albedo.eval(tex, g.uv, g.p) * std::f32::consts::FRAC_1_PI;
-            direct(scene, &hit, wo, c, |_wi, _n| kd)
+            direct(scene, &hit, wo, sampler, c, |_wi, _n| kd)
         }
         Material::Phong { ka, kd, ks, exponent } => {
             let (ka, kd, ks) = (ka.eval(tex, g.uv, g.p), kd.eval(tex, g.uv, g.p), ks.eval(tex, g.uv, g.p));
@@ -34,7 +36,7 @@ pub(super) fn radiance(scene: &Scene, ray: &Ray, depth: u32, c: &mut Counters) -
             // Classic Phong is not a BRDF: `kd` multiplies cos θ directly. Dividing by cos θ
             // here makes `direct` (which multiplies by it) produce exactly the textbook sum.
             ka * ambient
-                + direct(scene, &hit, wo, c, |wi, n| {
+                + direct(scene, &hit, wo, sampler, c, |wi, n| {
                     let cos = n.dot(wi).max(1e-8);
                     let spec = reflect(wi, n).dot(wo).max(0.0).powf(*exponent);
                     kd + ks * (spec / cos)
@@ -45,12 +47,12 @@ pub(super) fn radiance(scene: &Scene, ray: &Ray, depth: u32, c: &mut Counters) -
             let bsdf = m.bsdf(tex, g.uv, g.p);
             let frame = Frame::from_z(facing(g.ns, wo));
             let wo_local = frame.to_local(wo);
-            direct(scene, &hit, wo, c, |wi, _n| bsdf.eval(wo_local, frame.to_local(wi)))
+            direct(scene, &hit, wo, sampler, c, |wi, _n| bsdf.eval(wo_local, frame.to_local(wi)))
         }
         Material::Mirror { reflectance } => {
             let n = facing(g.ns, wo);
             let r = reflectance.eval(tex, g.uv, g.p);
-            r * radiance(scene, &hit.spawn(reflect(wo, n)), depth + 1, c)
+            r * radiance(scene, &hit.spawn(reflect(wo, n)), depth + 1, sampler, c)
         }
         Material::Dielectric { ior } => {
             // Which side are we on? The geometric normal decides; the shading normal bends.
@@ -58,10 +60,10 @@ pub(super) fn radiance(scene: &Scene, ray: &Ray, depth: u32, c: &mut Counters) -
             let n = if entering { g.ns } else { -g.ns };
             let eta = if entering { *ior } else { 1.0 / *ior };
             let f = fresnel_dielectric(wo.dot(n).clamp(-1.0, 1.0), eta);
-            let mut l = f * radiance(scene, &hit.spawn(reflect(wo, n)), depth + 1, c);
+            let mut l = f * radiance(scene, &hit.spawn(reflect(wo, n)), depth + 1, sampler, c);
             if f < 1.0 {
                 if let Some(wt) = refract(wo, n, eta) {
-                    l += (1.0 - f) * radiance(scene, &hit.spawn(wt), depth + 1, c);
+                    l += (1.0 - f) * radiance(scene, &hit.spawn(wt), depth + 1, sampler, c);
                 }
             }
             l
@@ -71,21 +73,24 @@ pub(super) fn radiance(scene: &Scene, ray: &Ray, depth: u32, c: &mut Counters) -
 
 /// Sum over the delta lights of `f(wi, n) · E · cos θ`, with shadow rays. Surfaces are
 /// two-sided: the shading normal is turned towards the viewer.
-fn direct(scene: &Scene, hit: &SurfaceHit, wo: Vec3, c: &mut Counters, f: impl Fn(Vec3, Vec3) -> Rgb) -> Rgb {
+fn direct(scene: &Scene, hit: &SurfaceHit, wo: Vec3, sampler: &mut PixelSampler, c: &mut Counters, f: impl Fn(Vec3, Vec3) -> Rgb) -> Rgb {
     let n = facing(hit.geom.ns, wo);
     let ng = facing(hit.geom.ng, wo);
     let mut l = Rgb::ZERO;
     for light in &scene.lights {
-        let Some(s) = light.sample(hit.geom.p) else { continue };
-        let cos = n.dot(s.wi);
-        // Light below the geometric surface would leak through it.
-        if cos <= 0.0 || ng.dot(s.wi) <= 0.0 {
-            continue;
+        for k in 0..light.sample_count() {
+            let u = if light.is_jittered() { sampler.get_2d() } else { Vec2::ZERO };
+            let Some(s) = light.sample(hit.geom.p, k, u) else { continue };
+            let cos = n.dot(s.wi);
+            // Light below the geometric surface would leak through it.
+            if cos <= 0.0 || ng.dot(s.wi) <= 0.0 {
+                continue;
+            }
+            if scene.occluded(&hit.spawn_to(s.wi, s.dist), c) {
+                continue;
+            }
+            l += f(s.wi, n) * s.irradiance * cos;
         }
-        if scene.occluded(&hit.spawn_to(s.wi, s.dist), c) {
-            continue;
-        }
-        l += f(s.wi, n) * s.irradiance * cos;
     }
     l
 }

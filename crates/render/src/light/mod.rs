@@ -5,7 +5,7 @@ mod area;
 
 pub use area::{AreaLights, AreaSample, LightSampling};
 
-use raylab_core::{Rgb, Vec3};
+use raylab_core::{sampling, Rgb, Vec2, Vec3};
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Light {
@@ -17,6 +17,10 @@ pub enum Light {
     Directional { direction: Vec3, irradiance: Rgb },
     /// The constant ambient term `I_ambient` of the Phong model (weighted by `ka`).
     Ambient { intensity: Rgb },
+    /// The first report's area light: an `n × n` grid of point lights over the
+    /// parallelogram `corner + s·edge_u + t·edge_v`, each jittered inside its cell and
+    /// carrying `intensity / n²` (so the total stays that of one point light).
+    Grid { corner: Vec3, edge_u: Vec3, edge_v: Vec3, n: u32, intensity: Rgb },
 }
 
 /// Light arriving at a point from one light.
@@ -36,26 +40,47 @@ impl Light {
             Light::Point { .. } => "point",
             Light::Directional { .. } => "directional",
             Light::Ambient { .. } => "ambient",
+            Light::Grid { .. } => "grid",
         }
     }
 
-    /// The light reaching `p`, or `None` for lights without a direction (ambient) or when
-    /// `p` coincides with a point light.
-    pub fn sample(&self, p: Vec3) -> Option<LightSample> {
+    /// How many samples [`Light::sample`] takes per shading point: `n²` for grids.
+    pub fn sample_count(&self) -> u32 {
         match *self {
-            Light::Point { position, intensity } => {
-                let d = position - p;
-                let d2 = d.length_squared();
-                if d2 == 0.0 {
-                    return None;
-                }
-                let dist = d2.sqrt();
-                Some(LightSample { wi: d / dist, dist, irradiance: intensity / d2 })
+            Light::Grid { n, .. } => n * n,
+            _ => 1,
+        }
+    }
+
+    /// Whether samples need a jitter value (`u` of [`Light::sample`]).
+    pub fn is_jittered(&self) -> bool {
+        matches!(self, Light::Grid { .. })
+    }
+
+    /// Sample `k` of [`Light::sample_count`] of the light reaching `p` (`u` jitters grid
+    /// cells), or `None` for lights without a direction (ambient) or when `p` coincides with
+    /// a point light.
+    pub fn sample(&self, p: Vec3, k: u32, u: Vec2) -> Option<LightSample> {
+        match *self {
+            Light::Point { position, intensity } => point(p, position, intensity),
+            Light::Grid { corner, edge_u, edge_v, n, intensity } => {
+                let cell = sampling::jittered(k, n, u);
+                point(p, corner + cell.x * edge_u + cell.y * edge_v, intensity / (n * n) as f32)
             }
             Light::Directional { direction, irradiance } => Some(LightSample { wi: -direction, dist: f32::INFINITY, irradiance }),
             Light::Ambient { .. } => None,
         }
     }
+}
+
+fn point(p: Vec3, position: Vec3, intensity: Rgb) -> Option<LightSample> {
+    let d = position - p;
+    let d2 = d.length_squared();
+    if d2 == 0.0 {
+        return None;
+    }
+    let dist = d2.sqrt();
+    Some(LightSample { wi: d / dist, dist, irradiance: intensity / d2 })
 }
 
 #[cfg(test)]
@@ -65,10 +90,23 @@ mod tests {
     #[test]
     fn point_light_falls_off_with_the_square_of_distance() {
         let l = Light::Point { position: Vec3::new(0.0, 2.0, 0.0), intensity: Rgb::splat(8.0) };
-        let s = l.sample(Vec3::ZERO).unwrap();
+        let s = l.sample(Vec3::ZERO, 0, Vec2::ZERO).unwrap();
         assert_eq!(s.wi, Vec3::Y);
         assert_eq!(s.dist, 2.0);
         assert_eq!(s.irradiance, Rgb::splat(2.0));
-        assert!(l.sample(Vec3::new(0.0, 2.0, 0.0)).is_none());
+        assert!(l.sample(Vec3::new(0.0, 2.0, 0.0), 0, Vec2::ZERO).is_none());
+    }
+
+    #[test]
+    fn grid_light_splits_its_intensity_over_jittered_cells() {
+        // A 2×2 grid over [0,2]×[0,2] at height 1: cell k with jitter u lies at
+        // ((k % 2 + u.x), 1, (k / 2 + u.y)), and carries a quarter of the intensity.
+        let l = Light::Grid { corner: Vec3::new(0.0, 1.0, 0.0), edge_u: Vec3::new(2.0, 0.0, 0.0), edge_v: Vec3::new(0.0, 0.0, 2.0), n: 2, intensity: Rgb::splat(8.0) };
+        assert_eq!(l.sample_count(), 4);
+        let s = l.sample(Vec3::new(1.5, 0.0, 0.5), 1, Vec2::splat(0.5)).unwrap();
+        assert!((s.wi - Vec3::Y).length() < 1e-6, "{}", s.wi);
+        assert_eq!(s.irradiance, Rgb::splat(2.0));
+        let s = l.sample(Vec3::new(0.0, 0.0, 0.0), 3, Vec2::ZERO).unwrap();
+        assert!((s.dist - 3f32.sqrt()).abs() < 1e-6);
     }
 }
