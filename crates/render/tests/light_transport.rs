@@ -91,3 +91,52 @@ fn path_tracer_passes_the_emitting_furnace() {
     let expected = 1.0 / (1.0 - rho);
     assert!((l - expected).abs() < 0.03 * expected, "{l} (expected {expected})");
 }
+
+/// The floor under a one-sided 1×1 rect light facing down at height h = 2, radiance 4:
+/// irradiance at the point below its centre is 4·π·Le·F(A, B) with the form factor of a
+/// corner-aligned rectangle F = (1/2π)[A/√(1+A²)·atan(B/√(1+A²)) + B/√(1+B²)·atan(A/√(1+B²))],
+/// A = B = 0.5/h; the floor's radiance is ρ/π·E = 0.146956.
+#[test]
+fn every_strategy_converges_to_the_rect_light_closed_form() {
+    let (a, h) = (0.5f64, 2.0f64);
+    let x = a / h;
+    let f = (2.0 * x / (1.0 + x * x).sqrt() * (x / (1.0 + x * x).sqrt()).atan()) / (2.0 * std::f64::consts::PI);
+    let expected = (0.5 / std::f64::consts::PI * 4.0 * std::f64::consts::PI * 4.0 * f) as f32;
+    assert!((expected - 0.146956).abs() < 1e-5, "{expected}");
+    for (strategy, tolerance) in [(LightSampling::Uniform, 0.02), (LightSampling::Cells, 0.02), (LightSampling::SolidAngle, 0.02), (LightSampling::Mis, 0.02), (LightSampling::Bsdf, 0.1)] {
+        let l = mean(&render(&rect_light_scene(strategy, 0.5, 2.0, 256), &|_| {}).pixels);
+        assert!((l - expected).abs() < expected * tolerance, "{strategy}: {l} (expected {expected})");
+    }
+}
+
+/// The floor seen from straight above under a square light of half-size `half` at height
+/// `h`, radiance 4, one-sided facing down.
+fn rect_light_scene(strategy: LightSampling, half: f32, h: f32, spp: u32) -> Scene {
+    let camera = Camera::new(Vec3::new(0.0, h / 2.0, 0.0), Vec3::ZERO, Vec3::Z, 1.0, 1.0, 0.0, None).unwrap();
+    let settings = RenderSettings { width: 8, height: 8, spp, sampler: SamplerKind::Random, integrator: IntegratorKind::Direct, light_sampling: strategy, max_depth: 2, ..Default::default() };
+    let mut scene = Scene::new(camera, settings);
+    let m = scene.add_material("floor", Material::Diffuse { albedo: TexColor::Constant(Rgb::splat(0.5)) });
+    let black = scene.add_material("light", Material::Diffuse { albedo: TexColor::Constant(Rgb::ZERO) });
+    scene.geometry.add_mesh(floor(m, 50.0));
+    // Vertices in order with (v1 - v0) × (v2 - v0) pointing down.
+    let v = |x: f32, z: f32| Vec3::new(x, h, z);
+    let positions = vec![v(-half, -half), v(half, -half), v(half, half), v(-half, half)];
+    scene.geometry.add_mesh(TriangleMesh { name: "rect".into(), positions, indices: vec![[0, 1, 2], [0, 2, 3]], material: black, emission: Rgb::splat(4.0), ..Default::default() });
+    scene.build_accel(&BuildOptions::default());
+    scene
+}
+
+#[test]
+fn cells_importance_sampling_beats_uniform_under_a_large_close_light() {
+    // A 10×10 light 0.3 above the floor: uniform area samples mostly land far away where
+    // they contribute little; the cells' CDF puts them above the point.
+    let spread = |s| {
+        let img = render(&rect_light_scene(s, 5.0, 0.3, 16), &|_| {});
+        let m = mean(&img.pixels);
+        (m, img.pixels.iter().map(|p| (p.y - m).powi(2)).sum::<f32>() / img.pixels.len() as f32)
+    };
+    let ((_, vu), (mc, vc)) = (spread(LightSampling::Uniform), spread(LightSampling::Cells));
+    // Closed form as above with A = B = 5 / 0.3: L = 1.99416.
+    assert!((mc - 1.99416).abs() < 0.03 * 1.99416, "cells mean {mc}");
+    assert!(vc < 0.25 * vu, "variance: cells {vc}, uniform {vu}");
+}

@@ -31,7 +31,7 @@ pub struct SceneArgs {
     /// Integrator: whitted, direct, path, normals, albedo, depth, heatmap, heatmap-tests
     #[arg(long)]
     pub integrator: Option<String>,
-    /// Area-light sampling of direct and path: uniform, solid-angle, bsdf or mis
+    /// Area-light sampling of direct and path: uniform, solid-angle, cells, bsdf or mis
     #[arg(long)]
     pub light_sampling: Option<String>,
     /// Acceleration structure (none, bvh, ...; see `raylab inspect --help`)

@@ -147,7 +147,7 @@ fn direct_light(scene: &Scene, hit: &SurfaceHit, bsdf: &Bsdf, frame: &Frame, wo:
     if scene.area_lights.is_empty() || !strategy.samples_lights() {
         return l;
     }
-    let Some(ls) = scene.area_lights.sample(&scene.geometry, hit.geom.p, strategy, u_choice, u) else { return l };
+    let Some(ls) = scene.area_lights.sample(&scene.geometry, hit.geom.p, frame.z, strategy, u_choice, u) else { return l };
     if ls.pdf <= 0.0 || !same_side(ls.wi) {
         return l;
     }

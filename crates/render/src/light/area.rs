@@ -20,6 +20,11 @@ pub enum LightSampling {
     /// Points distributed uniformly in the solid angle the light subtends: cones for
     /// spheres; triangles fall back to area sampling.
     SolidAngle,
+    /// The third report's importance sampling of parallelogram lights: a `k × k` grid of
+    /// cells, one chosen by a discrete CDF over the cells' unshadowed contributions
+    /// (evaluated at their centres), then a uniform point inside it. Other emitters fall
+    /// back to solid-angle sampling.
+    Cells,
     /// Only BSDF sampling: light is found when a sampled direction hits an emitter.
     Bsdf,
     /// Light samples (solid angle) and BSDF samples combined by the power heuristic
@@ -28,12 +33,13 @@ pub enum LightSampling {
 }
 
 impl LightSampling {
-    pub const ALL: &'static [LightSampling] = &[LightSampling::Uniform, LightSampling::SolidAngle, LightSampling::Bsdf, LightSampling::Mis];
+    pub const ALL: &'static [LightSampling] = &[LightSampling::Uniform, LightSampling::SolidAngle, LightSampling::Cells, LightSampling::Bsdf, LightSampling::Mis];
 
     pub fn name(self) -> &'static str {
         match self {
             LightSampling::Uniform => "uniform",
             LightSampling::SolidAngle => "solid-angle",
+            LightSampling::Cells => "cells",
             LightSampling::Bsdf => "bsdf",
             LightSampling::Mis => "mis",
         }
@@ -74,9 +80,29 @@ pub struct AreaSample {
     pub pdf: f32,
 }
 
+/// Cells per side of the `cells` strategy's grid.
+pub const CELLS: u32 = 8;
+
+/// Share of the `cells` strategy's choice spread uniformly over all cells: a cell whose
+/// centre sees no light may still light the point in part (defensive sampling, Hesterberg
+/// 1995), so every cell keeps a non-zero probability and the estimate stays unbiased.
+const CELLS_UNIFORM_SHARE: f32 = 0.1;
+
+/// An emitting mesh that is one parallelogram (two triangles `[0, 1, 2]`, `[0, 2, 3]`):
+/// sampled as a whole by the `cells` strategy.
+#[derive(Clone, Copy, Debug)]
+struct Parallelogram {
+    prims: [u32; 2],
+    corner: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+    normal: Vec3,
+}
+
 /// The scene's emitting primitives with a power-proportional choice among them.
 #[derive(Clone, Debug, Default)]
 pub struct AreaLights {
+    parallelograms: Vec<Parallelogram>,
     prims: Vec<u32>,
     /// Inclusive prefix sums of the emitters' powers, normalised to end at 1.
     cdf: Vec<f32>,
@@ -102,7 +128,7 @@ impl AreaLights {
         if let Some(last) = cdf.last_mut() {
             *last = 1.0;
         }
-        Self { prims, cdf, choice }
+        Self { parallelograms: find_parallelograms(geometry), prims, cdf, choice }
     }
 
     pub fn is_empty(&self) -> bool {
@@ -113,13 +139,20 @@ impl AreaLights {
         self.prims.len()
     }
 
-    /// Samples light arriving at `p` from one emitter. `u_choice` picks the emitter, `u` the
-    /// point on it.
-    pub fn sample(&self, geometry: &Geometry, p: Vec3, strategy: LightSampling, u_choice: f32, u: Vec2) -> Option<AreaSample> {
+    /// Samples light arriving at `p` (shading normal `n`, used by `cells`) from one
+    /// emitter. `u_choice` picks the emitter, `u` the point on it.
+    pub fn sample(&self, geometry: &Geometry, p: Vec3, n: Vec3, strategy: LightSampling, u_choice: f32, u: Vec2) -> Option<AreaSample> {
         let k = self.cdf.partition_point(|&c| c <= u_choice).min(self.prims.len().checked_sub(1)?);
         let prim = self.prims[k];
         let choice = self.choice[prim as usize];
         let le = geometry.emission(prim);
+        if strategy == LightSampling::Cells {
+            if let Some(quad) = self.parallelograms.iter().find(|q| q.prims.contains(&prim)) {
+                // Either triangle's choice leads here: the quad's probability is their sum.
+                let choice = quad.prims.iter().map(|&t| self.choice[t as usize]).sum::<f32>();
+                return sample_cells(quad, p, n, le, choice, u_choice_rescaled(u_choice, &self.cdf, k), u);
+            }
+        }
         match geometry.prim(prim) {
             PrimRef::Sphere(s) if strategy != LightSampling::Uniform => {
                 let sphere = &geometry.spheres[s as usize];
@@ -214,6 +247,77 @@ impl AreaLights {
         }
         choice / area(geometry, prim) * to.length_squared() / cos_l
     }
+}
+
+/// `u_choice` stretched back to [0, 1) within the CDF bin `k` it fell in: a fresh uniform
+/// number for a second discrete choice, without another sampler dimension.
+fn u_choice_rescaled(u: f32, cdf: &[f32], k: usize) -> f32 {
+    let lo = if k == 0 { 0.0 } else { cdf[k - 1] };
+    let hi = cdf[k];
+    if hi > lo { ((u - lo) / (hi - lo)).clamp(0.0, 1.0 - f32::EPSILON / 2.0) } else { 0.5 }
+}
+
+/// Emitting meshes made of exactly one parallelogram.
+fn find_parallelograms(geometry: &Geometry) -> Vec<Parallelogram> {
+    let mut out = Vec::new();
+    let mut first = 0u32;
+    for m in &geometry.meshes {
+        let n = m.len() as u32;
+        if m.emission != Rgb::ZERO && m.indices == [[0, 1, 2], [0, 2, 3]] && m.positions.len() == 4 {
+            let [a, b, c, d] = [m.positions[0], m.positions[1], m.positions[2], m.positions[3]];
+            let scale = (b - a).length().max((d - a).length());
+            if ((a + c) - (b + d)).length() <= 1e-5 * scale {
+                out.push(Parallelogram { prims: [first, first + 1], corner: a, e1: b - a, e2: d - a, normal: m.winding_normal(0) });
+            }
+        }
+        first += n;
+    }
+    out
+}
+
+/// The `cells` strategy on one parallelogram: cell weights are the unshadowed irradiance
+/// from each cell's centre, `max(0, n·ω) · max(0, n_l·-ω) / d²`, mixed with a uniform share.
+fn sample_cells(quad: &Parallelogram, p: Vec3, n: Vec3, le: Rgb, choice: f32, u_cell: f32, u: Vec2) -> Option<AreaSample> {
+    let k = CELLS as usize;
+    let mut weights = [0.0f32; (CELLS * CELLS) as usize];
+    let mut total = 0.0;
+    for (idx, w) in weights.iter_mut().enumerate() {
+        let centre = quad.corner + ((idx % k) as f32 + 0.5) / k as f32 * quad.e1 + ((idx / k) as f32 + 0.5) / k as f32 * quad.e2;
+        let d = centre - p;
+        let d2 = d.length_squared();
+        let wi = d / d2.sqrt();
+        *w = n.dot(wi).max(0.0) * quad.normal.dot(-wi).max(0.0) / d2;
+        total += *w;
+    }
+    let cells = weights.len() as f32;
+    let prob = |w: f32| if total > 0.0 { (1.0 - CELLS_UNIFORM_SHARE) * w / total + CELLS_UNIFORM_SHARE / cells } else { 1.0 / cells };
+    // Invert the discrete CDF.
+    let mut acc = 0.0;
+    let mut chosen = weights.len() - 1;
+    for (idx, &w) in weights.iter().enumerate() {
+        acc += prob(w);
+        if u_cell < acc {
+            chosen = idx;
+            break;
+        }
+    }
+    let cell = Vec2::new((chosen % k) as f32, (chosen / k) as f32);
+    let st = (cell + u) / k as f32;
+    let q = quad.corner + st.x * quad.e1 + st.y * quad.e2;
+    let to = q - p;
+    let d2 = to.length_squared();
+    let dist = d2.sqrt();
+    if dist <= 0.0 {
+        return None;
+    }
+    let wi = to / dist;
+    let cos_l = quad.normal.dot(-wi);
+    if cos_l <= 0.0 {
+        return None;
+    }
+    let area = quad.e1.cross(quad.e2).length();
+    let pdf_area = prob(weights[chosen]) * cells / area;
+    Some(AreaSample { wi, dist, le, pdf: choice * pdf_area * d2 / cos_l })
 }
 
 /// Surface area of a primitive (spheres untransformed: lights are not scaled).
