@@ -9,6 +9,7 @@ use std::ops::Range;
 
 use raylab_core::{Aabb, Ray};
 
+use crate::leaf::{any_hit, Closest};
 use crate::{Accel, AccelStats, Counters, Hit, Primitives, ValidationError};
 
 /// One box per object.
@@ -55,18 +56,9 @@ impl Accel for ObjectBoxes {
     fn intersect<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
         c.rays += 1;
         let mut ray = *ray;
-        let mut best = None;
-        self.walk(&mut ray, c, |ray, r, c| {
-            for p in r {
-                c.prim_tests += 1;
-                if let Some(h) = prims.intersect(p, ray) {
-                    ray.t_max = h.t;
-                    best = Some(Hit::new(p, h));
-                }
-            }
-            false
-        });
-        best
+        let mut closest = Closest::new(prims);
+        self.walk(&mut ray, c, |ray, r, c| closest.test(ray, r, c));
+        closest.best
     }
 
     fn occluded<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
@@ -74,10 +66,7 @@ impl Accel for ObjectBoxes {
         let mut ray = *ray;
         let mut hit = false;
         self.walk(&mut ray, c, |ray, r, c| {
-            hit = r.into_iter().any(|p| {
-                c.prim_tests += 1;
-                prims.intersect(p, ray).is_some()
-            });
+            hit = any_hit(prims, ray, r, c);
             hit
         });
         hit

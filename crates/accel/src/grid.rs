@@ -11,6 +11,7 @@
 use rayon::prelude::*;
 use raylab_core::{Aabb, Ray, Vec3};
 
+use crate::leaf::{any_hit, Closest};
 use crate::{robust_margin, Accel, AccelStats, BuildOptions, Counters, Hit, Primitives, ValidationError};
 
 /// Upper bound on primitive references (cell entries): 128 MiB of indices. A scene whose
@@ -245,16 +246,9 @@ impl Accel for Grid {
     fn intersect<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
         c.rays += 1;
         let mut ray = *ray;
-        let mut best = None;
-        self.walk(&mut ray, c, |ray, p, c| {
-            c.prim_tests += 1;
-            if let Some(h) = prims.intersect(p, ray) {
-                ray.t_max = h.t;
-                best = Some(Hit::new(p, h));
-            }
-            false
-        });
-        best
+        let mut closest = Closest::new(prims);
+        self.walk(&mut ray, c, |ray, p, c| closest.test(ray, [p], c));
+        closest.best
     }
 
     fn occluded<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
@@ -262,8 +256,7 @@ impl Accel for Grid {
         let mut ray = *ray;
         let mut hit = false;
         self.walk(&mut ray, c, |ray, p, c| {
-            c.prim_tests += 1;
-            hit = prims.intersect(p, ray).is_some();
+            hit = any_hit(prims, ray, [p], c);
             hit
         });
         hit

@@ -14,6 +14,7 @@ pub mod bvh;
 pub mod counters;
 pub mod grid;
 pub mod kdtree;
+mod leaf;
 pub mod primitives;
 pub mod sphere_bvh;
 pub mod stats;

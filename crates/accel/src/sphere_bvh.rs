@@ -9,6 +9,7 @@
 use rayon::prelude::*;
 use raylab_core::{Aabb, BoundingSphere, Ray, Vec3};
 
+use crate::leaf::{any_hit, Closest};
 use crate::bvh::{lbvh, ploc, SahCost};
 use crate::{robust_margin, Accel, AccelStats, BuildOptions, Counters, Hit, Primitives, ValidationError};
 
@@ -158,18 +159,9 @@ impl Accel for SphereBvh {
     fn intersect<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
         c.rays += 1;
         let mut ray = *ray;
-        let mut best = None;
-        self.walk(&mut ray, c, |ray, first, count, c| {
-            for &p in &self.indices[first..first + count] {
-                c.prim_tests += 1;
-                if let Some(h) = prims.intersect(p, ray) {
-                    ray.t_max = h.t;
-                    best = Some(Hit::new(p, h));
-                }
-            }
-            false
-        });
-        best
+        let mut closest = Closest::new(prims);
+        self.walk(&mut ray, c, |ray, first, count, c| closest.test(ray, self.indices[first..first + count].iter().copied(), c));
+        closest.best
     }
 
     fn occluded<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
@@ -177,10 +169,7 @@ impl Accel for SphereBvh {
         let mut ray = *ray;
         let mut hit = false;
         self.walk(&mut ray, c, |ray, first, count, c| {
-            hit = self.indices[first..first + count].iter().any(|&p| {
-                c.prim_tests += 1;
-                prims.intersect(p, ray).is_some()
-            });
+            hit = any_hit(prims, ray, self.indices[first..first + count].iter().copied(), c);
             hit
         });
         hit

@@ -4,24 +4,16 @@
 use raylab_core::Ray;
 
 use super::{Bvh, MAX_DEPTH};
+use crate::leaf::{any_hit, Closest};
 use crate::{Accel, AccelStats, Counters, Hit, Primitives, ValidationError};
 
 impl Accel for Bvh {
     fn intersect<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
         c.rays += 1;
         let mut ray = *ray;
-        let mut best = None;
-        self.walk(&mut ray, c, |ray, first, count, c| {
-            for &p in &self.indices[first..first + count] {
-                c.prim_tests += 1;
-                if let Some(h) = prims.intersect(p, ray) {
-                    ray.t_max = h.t;
-                    best = Some(Hit::new(p, h));
-                }
-            }
-            false
-        });
-        best
+        let mut closest = Closest::new(prims);
+        self.walk(&mut ray, c, |ray, first, count, c| closest.test(ray, self.indices[first..first + count].iter().copied(), c));
+        closest.best
     }
 
     fn occluded<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
@@ -29,14 +21,8 @@ impl Accel for Bvh {
         let mut ray = *ray;
         let mut hit = false;
         self.walk(&mut ray, c, |ray, first, count, c| {
-            for &p in &self.indices[first..first + count] {
-                c.prim_tests += 1;
-                if prims.intersect(p, ray).is_some() {
-                    hit = true;
-                    return true;
-                }
-            }
-            false
+            hit = any_hit(prims, ray, self.indices[first..first + count].iter().copied(), c);
+            hit
         });
         hit
     }

@@ -13,6 +13,7 @@ use raylab_core::Ray;
 
 use super::build::MAX_DEPTH;
 use super::KdTree;
+use crate::leaf::{any_hit, Closest};
 use crate::{Accel, AccelStats, Counters, Hit, Primitives, ValidationError};
 
 impl KdTree {
@@ -82,18 +83,9 @@ impl Accel for KdTree {
     fn intersect<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
         c.rays += 1;
         let mut ray = *ray;
-        let mut best = None;
-        self.walk(&mut ray, c, |ray, leaf, c| {
-            for &p in leaf {
-                c.prim_tests += 1;
-                if let Some(h) = prims.intersect(p, ray) {
-                    ray.t_max = h.t;
-                    best = Some(Hit::new(p, h));
-                }
-            }
-            false
-        });
-        best
+        let mut closest = Closest::new(prims);
+        self.walk(&mut ray, c, |ray, leaf, c| closest.test(ray, leaf.iter().copied(), c));
+        closest.best
     }
 
     fn occluded<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
@@ -101,10 +93,7 @@ impl Accel for KdTree {
         let mut ray = *ray;
         let mut hit = false;
         self.walk(&mut ray, c, |ray, leaf, c| {
-            hit = leaf.iter().any(|&p| {
-                c.prim_tests += 1;
-                prims.intersect(p, ray).is_some()
-            });
+            hit = any_hit(prims, ray, leaf.iter().copied(), c);
             hit
         });
         hit
