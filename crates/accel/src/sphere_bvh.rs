@@ -10,11 +10,9 @@ use rayon::prelude::*;
 use raylab_core::{Aabb, BoundingSphere, Ray, Vec3};
 
 use crate::leaf::{any_hit, Closest};
+use crate::bvh::traverse::{walk_tree, TreeNode};
 use crate::bvh::{lbvh, ploc, SahCost};
 use crate::{robust_margin, Accel, AccelStats, BuildOptions, Counters, Hit, Primitives, ValidationError};
-
-/// Deepest tree the traversal stack holds; [`lbvh::emit`] collapses anything deeper.
-const STACK: usize = crate::bvh::MAX_DEPTH + 1;
 
 /// One node, 24 bytes: interior when `count == 0` (children at `left_first` and
 /// `left_first + 1`), else a leaf of `indices[left_first .. left_first + count]`.
@@ -82,55 +80,8 @@ impl SphereBvh {
     /// Visits the leaves a ray may hit, nearest sphere first. `leaf(ray, first, count,
     /// counters)` may shrink `ray.t_max`; returning `true` stops the walk.
     #[inline]
-    fn walk(&self, ray: &mut Ray, c: &mut Counters, mut leaf: impl FnMut(&mut Ray, usize, usize, &mut Counters) -> bool) {
-        let Some(root) = self.nodes.first() else { return };
-        if root.sphere().intersect(ray).is_none() {
-            return;
-        }
-        let mut stack = [0u32; STACK];
-        let mut sp = 0usize;
-        let mut node = 0usize;
-        loop {
-            c.nodes_visited += 1;
-            let n = &self.nodes[node];
-            if n.is_leaf() {
-                if leaf(ray, n.left_first as usize, n.count as usize, c) {
-                    return;
-                }
-            } else {
-                let l = n.left_first as usize;
-                let dl = self.nodes[l].sphere().intersect(ray);
-                let dr = self.nodes[l + 1].sphere().intersect(ray);
-                match (dl, dr) {
-                    (Some((tl, _)), Some((tr, _))) => {
-                        let (near, far) = if tl <= tr { (l, l + 1) } else { (l + 1, l) };
-                        stack[sp] = far as u32;
-                        sp += 1;
-                        node = near;
-                        continue;
-                    }
-                    (Some(_), None) => {
-                        node = l;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        node = l + 1;
-                        continue;
-                    }
-                    (None, None) => {}
-                }
-            }
-            loop {
-                if sp == 0 {
-                    return;
-                }
-                sp -= 1;
-                node = stack[sp] as usize;
-                if self.nodes[node].sphere().intersect(ray).is_some() {
-                    break;
-                }
-            }
-        }
+    fn walk(&self, ray: &mut Ray, c: &mut Counters, leaf: impl FnMut(&mut Ray, usize, usize, &mut Counters) -> bool) {
+        walk_tree(&self.nodes, ray, c, leaf);
     }
 
     /// Visits every node with its depth (root depth 1).
@@ -153,6 +104,25 @@ impl SphereBvh {
 /// `inner` lies inside `outer` up to [`CONTAINMENT_TOLERANCE`].
 fn sphere_contains(outer: &BoundingSphere, inner: &BoundingSphere) -> bool {
     (inner.center - outer.center).length() + inner.radius <= outer.radius * (1.0 + CONTAINMENT_TOLERANCE)
+}
+
+impl TreeNode for SphereNode {
+    #[inline]
+    fn is_leaf(&self) -> bool {
+        self.count > 0
+    }
+    #[inline]
+    fn left_first(&self) -> usize {
+        self.left_first as usize
+    }
+    #[inline]
+    fn count(&self) -> usize {
+        self.count as usize
+    }
+    #[inline]
+    fn entry(&self, ray: &Ray, _inv_dir: Vec3) -> Option<f32> {
+        self.sphere().intersect(ray).map(|(t, _)| t)
+    }
 }
 
 impl Accel for SphereBvh {

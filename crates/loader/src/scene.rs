@@ -31,6 +31,21 @@ pub struct Overrides {
     pub seed: Option<u64>,
 }
 
+impl Overrides {
+    /// Replaces the settings the command line gave.
+    pub fn apply(&self, s: &mut RenderSettings) {
+        s.width = self.width.unwrap_or(s.width);
+        s.height = self.height.unwrap_or(s.height);
+        s.spp = self.spp.unwrap_or(s.spp);
+        s.max_depth = self.max_depth.unwrap_or(s.max_depth);
+        s.sampler = self.sampler.unwrap_or(s.sampler);
+        s.integrator = self.integrator.unwrap_or(s.integrator);
+        s.light_sampling = self.light_sampling.unwrap_or(s.light_sampling);
+        s.accel = self.accel.unwrap_or(s.accel);
+        s.seed = self.seed.unwrap_or(s.seed);
+    }
+}
+
 const TOP: &[&str] = &["camera", "render", "background", "textures", "materials", "shapes", "lights"];
 const CAMERA: &[&str] = &["from", "at", "up", "vfov", "width", "height", "aperture", "focus_distance"];
 const RENDER: &[&str] = &["spp", "sampler", "max_depth", "integrator", "light_sampling", "accel", "seed"];
@@ -151,15 +166,7 @@ impl Builder<'_> {
                 s.seed = in_range(&v, v.integer()?, 0, i64::MAX)? as u64;
             }
         }
-        s.width = o.width.unwrap_or(s.width);
-        s.height = o.height.unwrap_or(s.height);
-        s.spp = o.spp.unwrap_or(s.spp);
-        s.max_depth = o.max_depth.unwrap_or(s.max_depth);
-        s.sampler = o.sampler.unwrap_or(s.sampler);
-        s.integrator = o.integrator.unwrap_or(s.integrator);
-        s.light_sampling = o.light_sampling.unwrap_or(s.light_sampling);
-        s.accel = o.accel.unwrap_or(s.accel);
-        s.seed = o.seed.unwrap_or(s.seed);
+        o.apply(&mut s);
         if let Err(e) = s.sampler.check_spp(s.spp) {
             return Err(match (o.spp, spp_field) {
                 (None, Some(v)) => v.err(e),
@@ -593,15 +600,7 @@ pub fn load_mesh_scene(path: &Path, overrides: &Overrides) -> Result<Scene, Load
         return Err(LoadError::file(path, "the mesh has no triangles"));
     }
     let mut settings = RenderSettings::default();
-    settings.width = overrides.width.unwrap_or(settings.width);
-    settings.height = overrides.height.unwrap_or(settings.height);
-    settings.spp = overrides.spp.unwrap_or(settings.spp);
-    settings.max_depth = overrides.max_depth.unwrap_or(settings.max_depth);
-    settings.sampler = overrides.sampler.unwrap_or(settings.sampler);
-    settings.integrator = overrides.integrator.unwrap_or(settings.integrator);
-    settings.light_sampling = overrides.light_sampling.unwrap_or(settings.light_sampling);
-    settings.accel = overrides.accel.unwrap_or(settings.accel);
-    settings.seed = overrides.seed.unwrap_or(settings.seed);
+    overrides.apply(&mut settings);
     settings.sampler.check_spp(settings.spp).map_err(|e| LoadError::new(path, None, "--spp", e))?;
     let center = b.centroid();
     let radius = 0.5 * b.extent().length();

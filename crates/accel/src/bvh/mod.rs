@@ -12,7 +12,7 @@ mod node;
 pub mod ploc;
 mod sah;
 pub mod sbvh;
-mod traverse;
+pub(crate) mod traverse;
 
 pub use node::BvhNode;
 pub use sah::SahCost;

@@ -1,9 +1,10 @@
-//! Front-to-back traversal with an explicit stack: both children's boxes are tested and the
-//! nearer one is entered first, so that the closest hit shrinks `t_max` early.
+//! Front-to-back traversal of binary trees of bounding volumes (boxes here, spheres in
+//! `sphere_bvh.rs`): both children are tested and the nearer one entered first, so that the
+//! closest hit shrinks `t_max` early.
 
-use raylab_core::Ray;
+use raylab_core::{Ray, Vec3};
 
-use super::{Bvh, MAX_DEPTH};
+use super::{Bvh, BvhNode, MAX_DEPTH};
 use crate::leaf::{any_hit, Closest};
 use crate::{Accel, AccelStats, Counters, Hit, Primitives, ValidationError};
 
@@ -40,55 +41,90 @@ impl Bvh {
     /// Visits the leaves a ray may hit, nearest box first. `leaf(ray, first, count, counters)`
     /// may shrink `ray.t_max`; returning `true` stops the walk.
     #[inline]
-    fn walk(&self, ray: &mut Ray, c: &mut Counters, mut leaf: impl FnMut(&mut Ray, usize, usize, &mut Counters) -> bool) {
-        let Some(root) = self.nodes.first() else { return };
-        let inv = ray.inv_dir();
-        if root.bounds().intersect(ray.origin, inv, ray.t_min, ray.t_max).is_none() {
-            return;
-        }
-        let mut stack = [0u32; MAX_DEPTH + 1];
-        let mut sp = 0usize;
-        let mut node = 0usize;
-        loop {
-            c.nodes_visited += 1;
-            let n = &self.nodes[node];
-            if n.is_leaf() {
-                if leaf(ray, n.left_first as usize, n.count as usize, c) {
-                    return;
-                }
-            } else {
-                let l = n.left_first as usize;
-                let dl = self.nodes[l].bounds().intersect(ray.origin, inv, ray.t_min, ray.t_max);
-                let dr = self.nodes[l + 1].bounds().intersect(ray.origin, inv, ray.t_min, ray.t_max);
-                match (dl, dr) {
-                    (Some((tl, _)), Some((tr, _))) => {
-                        let (near, far) = if tl <= tr { (l, l + 1) } else { (l + 1, l) };
-                        stack[sp] = far as u32;
-                        sp += 1;
-                        node = near;
-                        continue;
-                    }
-                    (Some(_), None) => {
-                        node = l;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        node = l + 1;
-                        continue;
-                    }
-                    (None, None) => {}
-                }
+    fn walk(&self, ray: &mut Ray, c: &mut Counters, leaf: impl FnMut(&mut Ray, usize, usize, &mut Counters) -> bool) {
+        walk_tree(&self.nodes, ray, c, leaf);
+    }
+}
+
+/// A node of a binary tree stored with siblings adjacent and the root at 0 (BVHs of boxes
+/// or of spheres): what [`walk_tree`] needs of it.
+pub(crate) trait TreeNode {
+    fn is_leaf(&self) -> bool;
+    /// First child (interior) or first index (leaf).
+    fn left_first(&self) -> usize;
+    fn count(&self) -> usize;
+    /// Entry distance of the ray into the node's volume, if it enters within its interval.
+    fn entry(&self, ray: &Ray, inv_dir: Vec3) -> Option<f32>;
+}
+
+impl TreeNode for BvhNode {
+    #[inline]
+    fn is_leaf(&self) -> bool {
+        self.count > 0
+    }
+    #[inline]
+    fn left_first(&self) -> usize {
+        self.left_first as usize
+    }
+    #[inline]
+    fn count(&self) -> usize {
+        self.count as usize
+    }
+    #[inline]
+    fn entry(&self, ray: &Ray, inv_dir: Vec3) -> Option<f32> {
+        self.bounds().intersect(ray.origin, inv_dir, ray.t_min, ray.t_max).map(|(t, _)| t)
+    }
+}
+
+/// Front-to-back traversal with an explicit stack: both children's volumes are tested and
+/// the nearer one is entered first, so that the closest hit shrinks `t_max` early.
+#[inline]
+pub(crate) fn walk_tree<N: TreeNode>(nodes: &[N], ray: &mut Ray, c: &mut Counters, mut leaf: impl FnMut(&mut Ray, usize, usize, &mut Counters) -> bool) {
+    let Some(root) = nodes.first() else { return };
+    let inv = ray.inv_dir();
+    if root.entry(ray, inv).is_none() {
+        return;
+    }
+    let mut stack = [0u32; MAX_DEPTH + 1];
+    let mut sp = 0usize;
+    let mut node = 0usize;
+    loop {
+        c.nodes_visited += 1;
+        let n = &nodes[node];
+        if n.is_leaf() {
+            if leaf(ray, n.left_first(), n.count(), c) {
+                return;
             }
-            // Pop until a node that may still hold something nearer than the current hit.
-            loop {
-                if sp == 0 {
-                    return;
+        } else {
+            let l = n.left_first();
+            match (nodes[l].entry(ray, inv), nodes[l + 1].entry(ray, inv)) {
+                (Some(tl), Some(tr)) => {
+                    let (near, far) = if tl <= tr { (l, l + 1) } else { (l + 1, l) };
+                    stack[sp] = far as u32;
+                    sp += 1;
+                    node = near;
+                    continue;
                 }
-                sp -= 1;
-                node = stack[sp] as usize;
-                if self.nodes[node].bounds().intersect(ray.origin, inv, ray.t_min, ray.t_max).is_some() {
-                    break;
+                (Some(_), None) => {
+                    node = l;
+                    continue;
                 }
+                (None, Some(_)) => {
+                    node = l + 1;
+                    continue;
+                }
+                (None, None) => {}
+            }
+        }
+        // Pop until a node that may still hold something nearer than the current hit.
+        loop {
+            if sp == 0 {
+                return;
+            }
+            sp -= 1;
+            node = stack[sp] as usize;
+            if nodes[node].entry(ray, inv).is_some() {
+                break;
             }
         }
     }

@@ -208,18 +208,7 @@ impl AreaLights {
                 (sphere.to_world.point(sphere.center) + sphere.radius * n, n)
             }
         };
-        let to = q - p;
-        let d2 = to.length_squared();
-        let dist = d2.sqrt();
-        if dist <= 0.0 {
-            return None;
-        }
-        let wi = to / dist;
-        let cos_l = n.dot(-wi);
-        if cos_l <= 0.0 {
-            return None; // the back of a one-sided emitter
-        }
-        Some(AreaSample { wi, dist, le, pdf: choice / area(geometry, prim) * d2 / cos_l })
+        towards(p, q, n, le, choice / area(geometry, prim))
     }
 
     /// Solid-angle density with which `sample` would pick direction `wi` from `p` towards
@@ -304,6 +293,13 @@ fn sample_cells(quad: &Parallelogram, p: Vec3, n: Vec3, le: Rgb, choice: f32, u_
     let cell = Vec2::new((chosen % k) as f32, (chosen / k) as f32);
     let st = (cell + u) / k as f32;
     let q = quad.corner + st.x * quad.e1 + st.y * quad.e2;
+    let area = quad.e1.cross(quad.e2).length();
+    towards(p, q, quad.normal, le, choice * prob(weights[chosen]) * cells / area)
+}
+
+/// The sample of light point `q` (normal `n`) from `p`, its area density `pdf_area`
+/// converted to solid angle; `None` from the back of a one-sided emitter.
+fn towards(p: Vec3, q: Vec3, n: Vec3, le: Rgb, pdf_area: f32) -> Option<AreaSample> {
     let to = q - p;
     let d2 = to.length_squared();
     let dist = d2.sqrt();
@@ -311,13 +307,11 @@ fn sample_cells(quad: &Parallelogram, p: Vec3, n: Vec3, le: Rgb, choice: f32, u_
         return None;
     }
     let wi = to / dist;
-    let cos_l = quad.normal.dot(-wi);
+    let cos_l = n.dot(-wi);
     if cos_l <= 0.0 {
         return None;
     }
-    let area = quad.e1.cross(quad.e2).length();
-    let pdf_area = prob(weights[chosen]) * cells / area;
-    Some(AreaSample { wi, dist, le, pdf: choice * pdf_area * d2 / cos_l })
+    Some(AreaSample { wi, dist, le, pdf: pdf_area * d2 / cos_l })
 }
 
 /// Surface area of a primitive (spheres untransformed: lights are not scaled).
