@@ -66,11 +66,11 @@ pub fn csv(points: &[ConvergencePoint]) -> String {
     s
 }
 
-/// The study as one self-contained HTML page: `intro` (HTML) on top, log–log charts of MSE
+/// The study as one self-contained HTML page: `intro` (plain text) on top, log–log charts of MSE
 /// against spp and against seconds, a table of the fitted slopes and final errors, and the
 /// `images` side by side.
 pub fn html(intro: &str, points: &[ConvergencePoint], images: &[LabelledImage]) -> String {
-    let mut h = format!("<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>raylab converge</title><style>{STYLE}</style></head><body><h1>raylab converge</h1><p>{intro}</p>");
+    let mut h = format!("<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>raylab converge</title><style>{STYLE}</style></head><body><h1>raylab converge</h1><p>{}</p>", esc(intro));
     let series = |x: fn(&ConvergencePoint) -> f64| {
         let mut m: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
         for p in points {
@@ -152,6 +152,6 @@ mod tests {
         assert_eq!(page.matches("<svg").count(), 2);
         assert!(page.contains("<td>mis</td><td>-1.000</td><td>3</td><td>16</td>"), "{page}");
         assert!(page.contains("src=\"data:image/png;base64,Zm9v\""));
-        assert!(page.contains("a <b>study</b>"));
+        assert!(page.contains("<p>a &lt;b&gt;study&lt;/b&gt;</p>"));
     }
 }
