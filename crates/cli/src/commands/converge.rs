@@ -95,7 +95,7 @@ pub fn run(a: &ConvergeArgs) -> Result<()> {
                 let path = a.output.join("reference.exr");
                 write_image(&path, w, h, &pixels, Tonemap::Clamp, 0.0)?;
                 println!("no --reference given: rendered one with mis at {} spp ({})", a.reference_spp, path.display());
-                (pixels, format!("reference (mis, {} spp)", a.reference_spp))
+                (pixels, format!("reference (mis, {} spp, another seed)", a.reference_spp))
             }
         };
         let mut points = Vec::new();
