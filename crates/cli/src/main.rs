@@ -27,6 +27,8 @@ enum Command {
     Trace(commands::trace::TraceArgs),
     /// Compare two images: MSE, RMSE, relative MSE, and a false-colour difference image
     Compare(commands::compare::CompareArgs),
+    /// Measure how light-sampling strategies converge: MSE against samples and time
+    Converge(commands::converge::ConvergeArgs),
     /// Write a procedural test scene of any size (Haines' Standard Procedural Databases)
     Gen(commands::gen::GenArgs),
 }
@@ -41,6 +43,7 @@ fn main() -> ExitCode {
         Some(Command::Bench(a)) => commands::bench::run(&a),
         Some(Command::Trace(a)) => commands::trace::run(&a),
         Some(Command::Compare(a)) => commands::compare::run(&a),
+        Some(Command::Converge(a)) => commands::converge::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -30,7 +30,7 @@ const PALETTE: [RGBColor; 10] = [
     RGBColor(23, 190, 207),
 ];
 
-fn esc(s: &str) -> String {
+pub(crate) fn esc(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
 }
 
@@ -79,8 +79,8 @@ fn svg_fallback(title: &str) -> String {
     format!("<p>({} could not be drawn)</p>", esc(title))
 }
 
-/// One line per structure through `(x, y)` points, both axes logarithmic.
-fn loglog_chart(title: &str, x_desc: &str, y_desc: &str, series: &BTreeMap<String, Vec<(f64, f64)>>) -> String {
+/// One line per series (a structure, a strategy) through `(x, y)` points, both axes logarithmic.
+pub(crate) fn loglog_chart(title: &str, x_desc: &str, y_desc: &str, series: &BTreeMap<String, Vec<(f64, f64)>>) -> String {
     let pts: Vec<(f64, f64)> = series.values().flatten().copied().filter(|(x, y)| *x > 0.0 && *y > 0.0).collect();
     if pts.len() < 2 {
         return String::new();
@@ -116,7 +116,7 @@ fn loglog_chart(title: &str, x_desc: &str, y_desc: &str, series: &BTreeMap<Strin
     svg
 }
 
-fn base64(bytes: &[u8]) -> String {
+pub(crate) fn base64(bytes: &[u8]) -> String {
     const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
     for c in bytes.chunks(3) {
@@ -132,16 +132,17 @@ fn base64(bytes: &[u8]) -> String {
     out
 }
 
+/// The style sheet of the lab's HTML pages.
+pub(crate) const STYLE: &str = "body{font-family:sans-serif;max-width:1200px;margin:2em auto;color:#222} table{border-collapse:collapse;margin:1em 0}\
+    td,th{border:1px solid #ccc;padding:3px 8px;text-align:right} th{background:#f2f2f2} td:first-child{text-align:left}\
+    .charts{display:flex;flex-wrap:wrap;gap:8px} .thumbs img{width:240px;margin:4px;image-rendering:pixelated} figure{display:inline-block;margin:4px}";
+
 /// The whole report as one HTML page.
 pub fn html(report: &BenchReport, thumbnails: &[Thumbnail]) -> String {
     let mut h = String::new();
     let _ = write!(
         h,
-        "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>raylab bench</title><style>\
-         body{{font-family:sans-serif;max-width:1200px;margin:2em auto;color:#222}} table{{border-collapse:collapse;margin:1em 0}}\
-         td,th{{border:1px solid #ccc;padding:3px 8px;text-align:right}} th{{background:#f2f2f2}} td:first-child{{text-align:left}}\
-         .charts{{display:flex;flex-wrap:wrap;gap:8px}} .thumbs img{{width:240px;margin:4px;image-rendering:pixelated}} figure{{display:inline-block;margin:4px}}\
-         </style></head><body><h1>raylab bench</h1><p>raylab {} on {} ({} threads); medians of {} timed passes after a warm-up; \
+        "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>raylab bench</title><style>{STYLE}</style></head><body><h1>raylab bench</h1><p>raylab {} on {} ({} threads); medians of {} timed passes after a warm-up; \
          primary rays on a {}-pixel-wide grid. Every structure's hit count and sum of hit distances matched the oracle.</p>",
         esc(&report.raylab_version),
         esc(&report.machine.cpu),

@@ -1,5 +1,6 @@
 pub mod bench;
 pub mod compare;
+pub mod converge;
 pub mod gen;
 pub mod inspect;
 pub mod render;

@@ -13,15 +13,26 @@ use raylab_render::{IntegratorKind, SamplerKind, Scene};
 pub struct SceneArgs {
     /// Scene file (TOML) or bare mesh (OBJ, .obj.gz); the embedded default scene when omitted
     pub scene: Option<PathBuf>,
+    #[command(flatten)]
+    pub settings: SettingsArgs,
+    /// Samples per pixel (a square number for the jittered sampler)
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1048576))]
+    pub spp: Option<u32>,
+    /// Area-light sampling of direct and path: uniform, solid-angle, cells, bsdf or mis
+    #[arg(long)]
+    pub light_sampling: Option<String>,
+}
+
+/// The overrides of a scene's settings other than samples per pixel and light sampling,
+/// which `raylab converge` varies itself.
+#[derive(Args, Clone, Debug, Default)]
+pub struct SettingsArgs {
     /// Image width in pixels (overrides the scene's)
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub width: Option<u32>,
     /// Image height in pixels (overrides the scene's)
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub height: Option<u32>,
-    /// Samples per pixel (a square number for the jittered sampler)
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1048576))]
-    pub spp: Option<u32>,
     /// Pixel sampler: random, jittered (stratified) or sobol (scrambled low-discrepancy)
     #[arg(long)]
     pub sampler: Option<String>,
@@ -31,9 +42,6 @@ pub struct SceneArgs {
     /// Integrator: whitted, direct, path, normals, albedo, depth, heatmap, heatmap-tests
     #[arg(long)]
     pub integrator: Option<String>,
-    /// Area-light sampling of direct and path: uniform, solid-angle, cells, bsdf or mis
-    #[arg(long)]
-    pub light_sampling: Option<String>,
     /// Acceleration structure (none, bvh, ...; see `raylab inspect --help`)
     #[arg(long)]
     pub accel: Option<String>,
@@ -45,19 +53,19 @@ pub struct SceneArgs {
     pub threads: Option<u32>,
 }
 
-impl SceneArgs {
+impl SettingsArgs {
+    /// The overrides, with no spp or light sampling.
     pub fn overrides(&self) -> Result<Overrides> {
         let parse_accel = |s: &String| s.parse::<AccelKind>().map_err(|e| anyhow::anyhow!("--accel: {e}"));
         Ok(Overrides {
             width: self.width,
             height: self.height,
-            spp: self.spp,
             max_depth: self.max_depth,
             sampler: self.sampler.as_ref().map(|s| s.parse::<SamplerKind>().map_err(|e| anyhow::anyhow!("--sampler: {e}"))).transpose()?,
             integrator: self.integrator.as_ref().map(|s| s.parse::<IntegratorKind>().map_err(|e| anyhow::anyhow!("--integrator: {e}"))).transpose()?,
-            light_sampling: self.light_sampling.as_ref().map(|s| s.parse::<LightSampling>().map_err(|e| anyhow::anyhow!("--light-sampling: {e}"))).transpose()?,
             accel: self.accel.as_ref().map(parse_accel).transpose()?,
             seed: self.seed,
+            ..Overrides::default()
         })
     }
 
@@ -68,6 +76,20 @@ impl SceneArgs {
             b = b.num_threads(t as usize);
         }
         Ok(b.build()?)
+    }
+}
+
+impl SceneArgs {
+    pub fn overrides(&self) -> Result<Overrides> {
+        Ok(Overrides {
+            spp: self.spp,
+            light_sampling: self.light_sampling.as_ref().map(|s| s.parse::<LightSampling>().map_err(|e| anyhow::anyhow!("--light-sampling: {e}"))).transpose()?,
+            ..self.settings.overrides()?
+        })
+    }
+
+    pub fn pool(&self) -> Result<rayon::ThreadPool> {
+        self.settings.pool()
     }
 
     pub fn scene_name(&self) -> String {
