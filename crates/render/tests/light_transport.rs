@@ -118,6 +118,9 @@ fn rect_light_scene(strategy: LightSampling, half: f32, h: f32, spp: u32) -> Sce
     let m = scene.add_material("floor", Material::Diffuse { albedo: TexColor::Constant(Rgb::splat(0.5)) });
     let black = scene.add_material("light", Material::Diffuse { albedo: TexColor::Constant(Rgb::ZERO) });
     scene.geometry.add_mesh(floor(m, 50.0));
+    // A sphere out of the way, added before the light: primitive indices no longer follow
+    // mesh order (the `cells` strategy once lost its rects that way).
+    scene.geometry.add_sphere(Sphere { center: Vec3::new(40.0, 1.0, 40.0), radius: 0.5, to_world: Transform::IDENTITY, material: m, emission: Rgb::ZERO });
     // Vertices in order with (v1 - v0) × (v2 - v0) pointing down.
     let v = |x: f32, z: f32| Vec3::new(x, h, z);
     let positions = vec![v(-half, -half), v(half, -half), v(half, half), v(-half, half)];

@@ -248,18 +248,19 @@ fn u_choice_rescaled(u: f32, cdf: &[f32], k: usize) -> f32 {
 
 /// Emitting meshes made of exactly one parallelogram.
 fn find_parallelograms(geometry: &Geometry) -> Vec<Parallelogram> {
+    use raylab_accel::Primitives;
     let mut out = Vec::new();
-    let mut first = 0u32;
-    for m in &geometry.meshes {
-        let n = m.len() as u32;
+    // A mesh's primitives are consecutive: its first triangle's index locates the rest.
+    for prim in 0..geometry.len() as u32 {
+        let PrimRef::Triangle { mesh, tri: 0 } = geometry.prim(prim) else { continue };
+        let m = &geometry.meshes[mesh as usize];
         if m.emission != Rgb::ZERO && m.indices == [[0, 1, 2], [0, 2, 3]] && m.positions.len() == 4 {
             let [a, b, c, d] = [m.positions[0], m.positions[1], m.positions[2], m.positions[3]];
             let scale = (b - a).length().max((d - a).length());
             if ((a + c) - (b + d)).length() <= 1e-5 * scale {
-                out.push(Parallelogram { prims: [first, first + 1], corner: a, e1: b - a, e2: d - a, normal: m.winding_normal(0) });
+                out.push(Parallelogram { prims: [prim, prim + 1], corner: a, e1: b - a, e2: d - a, normal: m.winding_normal(0) });
             }
         }
-        first += n;
     }
     out
 }
