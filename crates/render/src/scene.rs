@@ -2,7 +2,7 @@ use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Primitive
 use raylab_core::{offset_ray_origin, Ray, Rgb, Vec3};
 
 use crate::camera::Camera;
-use crate::integrator::IntegratorKind;
+use crate::integrator::kind::IntegratorKind;
 use crate::light::{AreaLights, Light, LightSampling};
 use crate::material::{Material, MaterialId, TextureId};
 use crate::sampler::SamplerKind;

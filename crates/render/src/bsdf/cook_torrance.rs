@@ -15,7 +15,7 @@ use std::f32::consts::FRAC_1_PI;
 
 use super::lobe_probability;
 use super::microfacet::{schlick, Distribution, Geometry, MIN_ALPHA};
-use crate::material::reflect;
+use super::fresnel::reflect;
 
 pub(super) struct CookTorrance {
     pub diffuse: Rgb,

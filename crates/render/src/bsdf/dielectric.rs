@@ -7,7 +7,7 @@
 use raylab_core::{Rgb, Vec3};
 
 use super::{delta_sample, BsdfSample};
-use crate::material::{fresnel_dielectric, refract};
+use super::fresnel::{fresnel_dielectric, refract};
 
 pub(super) fn sample(ior: f32, wo: Vec3, u_lobe: f32) -> Option<BsdfSample> {
     let r = fresnel_dielectric(wo.z, ior);

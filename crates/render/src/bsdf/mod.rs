@@ -14,6 +14,7 @@
 
 mod cook_torrance;
 mod dielectric;
+mod fresnel;
 mod lambert;
 mod microfacet;
 mod mirror;
@@ -21,6 +22,7 @@ mod phong;
 #[cfg(test)]
 mod tests;
 
+pub use fresnel::{fresnel_dielectric, reflect, refract};
 pub use microfacet::{Distribution, Geometry};
 
 use raylab_core::color::luminance;

@@ -14,7 +14,7 @@ use raylab_core::sampling::{cosine_hemisphere, cosine_hemisphere_pdf};
 use raylab_core::{Frame, Rgb, Vec2, Vec3};
 
 use super::lobe_probability;
-use crate::material::reflect;
+use super::fresnel::reflect;
 
 pub(super) struct Phong {
     pub kd: Rgb,

@@ -9,7 +9,7 @@ use raylab_core::{Pcg32, Rgb, Vec2, Vec3};
 
 use super::microfacet::schlick;
 use super::*;
-use crate::material::fresnel_dielectric;
+use super::fresnel_dielectric;
 
 /// Unit vector with `cos θ = cos_theta` and azimuth `phi`.
 fn dir(cos_theta: f32, phi: f32) -> Vec3 {

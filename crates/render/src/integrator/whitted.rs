@@ -10,7 +10,8 @@ use raylab_core::{Frame, Ray, Rgb, Vec2, Vec3};
 use crate::sampler::PixelSampler;
 
 use crate::light::Light;
-use crate::material::{fresnel_dielectric, reflect, refract, Material};
+use crate::bsdf::{fresnel_dielectric, reflect, refract};
+use crate::material::Material;
 use crate::scene::SurfaceHit;
 use crate::Scene;
 

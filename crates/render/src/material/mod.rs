@@ -1,10 +1,6 @@
 //! Materials: what a surface does with light. Whitted shading reads their parameters
 //! directly (`integrator/whitted.rs`).
 
-mod fresnel;
-
-pub use fresnel::{fresnel_dielectric, reflect, refract};
-
 use raylab_core::{Rgb, Vec2, Vec3};
 
 use crate::bsdf::{Bsdf, Distribution, Geometry as MicrofacetGeometry};
