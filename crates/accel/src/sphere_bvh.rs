@@ -9,8 +9,7 @@
 use rayon::prelude::*;
 use raylab_core::{Aabb, BoundingSphere, Ray, Vec3};
 
-use crate::leaf::{any_hit, Closest};
-use crate::bvh::traverse::{walk_tree, TreeNode};
+use crate::bvh::traverse::{any_in_tree, closest_in_tree, TreeNode};
 use crate::bvh::{lbvh, ploc, SahCost};
 use crate::{robust_margin, Accel, AccelStats, BuildOptions, Counters, Hit, Primitives, ValidationError};
 
@@ -77,13 +76,6 @@ impl SphereBvh {
         Self { nodes, indices, primitives: n, build_ms: 0.0 }
     }
 
-    /// Visits the leaves a ray may hit, nearest sphere first. `leaf(ray, first, count,
-    /// counters)` may shrink `ray.t_max`; returning `true` stops the walk.
-    #[inline]
-    fn walk(&self, ray: &mut Ray, c: &mut Counters, leaf: impl FnMut(&mut Ray, usize, usize, &mut Counters) -> bool) {
-        walk_tree(&self.nodes, ray, c, leaf);
-    }
-
     /// Visits every node with its depth (root depth 1).
     fn visit(&self, mut f: impl FnMut(usize, usize)) {
         if self.nodes.is_empty() {
@@ -127,22 +119,11 @@ impl TreeNode for SphereNode {
 
 impl Accel for SphereBvh {
     fn intersect<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
-        c.rays += 1;
-        let mut ray = *ray;
-        let mut closest = Closest::new(prims);
-        self.walk(&mut ray, c, |ray, first, count, c| closest.test(ray, self.indices[first..first + count].iter().copied(), c));
-        closest.best
+        closest_in_tree(&self.nodes, &self.indices, prims, ray, c)
     }
 
     fn occluded<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
-        c.rays += 1;
-        let mut ray = *ray;
-        let mut hit = false;
-        self.walk(&mut ray, c, |ray, first, count, c| {
-            hit = any_hit(prims, ray, self.indices[first..first + count].iter().copied(), c);
-            hit
-        });
-        hit
+        any_in_tree(&self.nodes, &self.indices, prims, ray, c)
     }
 
     fn stats(&self) -> AccelStats {

@@ -10,22 +10,11 @@ use crate::{Accel, AccelStats, Counters, Hit, Primitives, ValidationError};
 
 impl Accel for Bvh {
     fn intersect<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
-        c.rays += 1;
-        let mut ray = *ray;
-        let mut closest = Closest::new(prims);
-        self.walk(&mut ray, c, |ray, first, count, c| closest.test(ray, self.indices[first..first + count].iter().copied(), c));
-        closest.best
+        closest_in_tree(&self.nodes, &self.indices, prims, ray, c)
     }
 
     fn occluded<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
-        c.rays += 1;
-        let mut ray = *ray;
-        let mut hit = false;
-        self.walk(&mut ray, c, |ray, first, count, c| {
-            hit = any_hit(prims, ray, self.indices[first..first + count].iter().copied(), c);
-            hit
-        });
-        hit
+        any_in_tree(&self.nodes, &self.indices, prims, ray, c)
     }
 
     fn stats(&self) -> AccelStats {
@@ -37,13 +26,27 @@ impl Accel for Bvh {
     }
 }
 
-impl Bvh {
-    /// Visits the leaves a ray may hit, nearest box first. `leaf(ray, first, count, counters)`
-    /// may shrink `ray.t_max`; returning `true` stops the walk.
-    #[inline]
-    fn walk(&self, ray: &mut Ray, c: &mut Counters, leaf: impl FnMut(&mut Ray, usize, usize, &mut Counters) -> bool) {
-        walk_tree(&self.nodes, ray, c, leaf);
-    }
+/// Closest hit in a tree whose leaves point into `indices`.
+#[inline]
+pub(crate) fn closest_in_tree<N: TreeNode, P: Primitives + ?Sized>(nodes: &[N], indices: &[u32], prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
+    c.rays += 1;
+    let mut ray = *ray;
+    let mut closest = Closest::new(prims);
+    walk_tree(nodes, &mut ray, c, |ray, first, count, c| closest.test(ray, indices[first..first + count].iter().copied(), c));
+    closest.best
+}
+
+/// Any hit in a tree whose leaves point into `indices`; stops at the first.
+#[inline]
+pub(crate) fn any_in_tree<N: TreeNode, P: Primitives + ?Sized>(nodes: &[N], indices: &[u32], prims: &P, ray: &Ray, c: &mut Counters) -> bool {
+    c.rays += 1;
+    let mut ray = *ray;
+    let mut hit = false;
+    walk_tree(nodes, &mut ray, c, |ray, first, count, c| {
+        hit = any_hit(prims, ray, indices[first..first + count].iter().copied(), c);
+        hit
+    });
+    hit
 }
 
 /// A node of a binary tree stored with siblings adjacent and the root at 0 (BVHs of boxes
