@@ -55,7 +55,7 @@ const MATERIAL: &[&str] = &[
     "name", "type", "albedo", "ka", "kd", "ks", "exponent", "reflectance", "ior", "diffuse", "specular", "roughness", "distribution", "geometry", "f0",
 ];
 const SHAPE: &[&str] = &["type", "material", "transform", "center", "radius", "vertices", "normals", "uvs", "file", "smooth"];
-const LIGHT: &[&str] = &["type", "position", "intensity", "direction", "irradiance", "vertices", "radiance", "center", "radius", "n"];
+const LIGHT: &[&str] = &["type", "position", "intensity", "direction", "irradiance", "vertices", "radiance", "texture", "center", "radius", "n"];
 const TRANSFORM_STEP: &[&str] = &["scale", "rotate", "translate"];
 const ROTATE: &[&str] = &["axis", "degrees"];
 
@@ -505,7 +505,7 @@ impl Builder<'_> {
             "point" => &["position", "intensity"],
             "directional" => &["direction", "irradiance"],
             "grid" => &["vertices", "n", "intensity"],
-            "rect" => &["vertices", "radiance"],
+            "rect" => &["vertices", "radiance", "texture"],
             "sphere" => &["center", "radius", "radiance"],
             _ => &["intensity"],
         };
@@ -569,6 +569,14 @@ impl Builder<'_> {
             return Ok(());
         }
         let verts = self.quad_vertices(t)?;
+        // A textured rect (the third report's window) emits `radiance × texture(uv)`.
+        let emission_texture = match t.get("texture") {
+            Some(v) => match self.tex_color(&v)? {
+                TexColor::Texture(id) => Some(id),
+                TexColor::Constant(_) => return Err(v.err("expected the name of a texture")),
+            },
+            None => None,
+        };
         let mesh = TriangleMesh {
             name: "rect light".into(),
             positions: verts,
@@ -576,6 +584,7 @@ impl Builder<'_> {
             uvs: vec![Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0)],
             material: black,
             emission: radiance,
+            emission_texture,
             ..Default::default()
         };
         scene.geometry.add_mesh(mesh);

@@ -123,6 +123,16 @@ impl Scene {
         self.accel.occluded(&self.geometry, ray, counters)
     }
 
+    /// Radiance the surface at `hit` emits towards `w` (zero for non-emitters), its emission
+    /// texture applied.
+    pub fn emitted(&self, hit: &SurfaceHit, w: Vec3) -> Rgb {
+        let le = self.geometry.emitted(hit.prim, &hit.geom, w);
+        match self.geometry.emission_texture(hit.prim) {
+            Some(t) if le != Rgb::ZERO => le * self.textures[t.0 as usize].eval(hit.geom.uv, hit.geom.p),
+            _ => le,
+        }
+    }
+
     pub fn background(&self, dir: Vec3) -> Rgb {
         match self.background {
             Background::Color(c) => c,

@@ -143,3 +143,31 @@ fn cells_importance_sampling_beats_uniform_under_a_large_close_light() {
     assert!((mc - 1.99416).abs() < 0.03 * 1.99416, "cells mean {mc}");
     assert!(vc < 0.25 * vu, "variance: cells {vc}, uniform {vu}");
 }
+
+#[test]
+fn textured_rect_lights_scale_their_radiance_by_the_texture() {
+    use raylab_render::texture::{Checker, CheckerSpace, Texture};
+    // A constant texture of 0.5 halves the closed form of the 1×1 light above (0.146956).
+    let mut estimates = Vec::new();
+    for strategy in [LightSampling::Uniform, LightSampling::Cells, LightSampling::Mis] {
+        let mut scene = rect_light_scene(strategy, 0.5, 2.0, 256);
+        scene.settings.sampler = SamplerKind::Sobol;
+        let t = scene.add_texture("half", Texture::Constant(Rgb::splat(0.5)));
+        scene.geometry.meshes.last_mut().unwrap().emission_texture = Some(t);
+        let l = mean(&render(&scene, &|_| {}).pixels);
+        assert!((l - 0.073478).abs() < 0.02 * 0.073478, "{strategy}: {l}");
+        // A window of 4×4 panes, alternately clear and black: strategies must agree.
+        let mut scene = rect_light_scene(strategy, 0.5, 2.0, 1024);
+        scene.settings.sampler = SamplerKind::Sobol;
+        let panes = Checker { even: Rgb::ONE, odd: Rgb::ZERO, scale: 4.0, space: CheckerSpace::Uv };
+        let t = scene.add_texture("window", Texture::Checker(panes));
+        scene.geometry.meshes.last_mut().unwrap().emission_texture = Some(t);
+        estimates.push((strategy, mean(&render(&scene, &|_| {}).pixels)));
+    }
+    let (_, reference) = estimates[0];
+    // Half the panes are black and the light is symmetric about the point: about half.
+    assert!((reference - 0.073478).abs() < 0.1 * 0.073478, "{reference}");
+    for (strategy, l) in estimates {
+        assert!((l - reference).abs() < 0.03 * reference, "{strategy}: {l} against uniform {reference}");
+    }
+}

@@ -70,7 +70,7 @@ pub(super) fn radiance(scene: &Scene, camera_ray: &Ray, sampler: &mut PixelSampl
             break;
         };
         let wo = -ray.dir.normalize();
-        let le = scene.geometry.emitted(hit.prim, &hit.geom, wo);
+        let le = scene.emitted(&hit, wo);
         if le != Rgb::ZERO {
             let weight = if specular || strategy == LightSampling::Bsdf {
                 1.0
@@ -147,7 +147,7 @@ fn direct_light(scene: &Scene, hit: &SurfaceHit, bsdf: &Bsdf, frame: &Frame, wo:
     if scene.area_lights.is_empty() || !strategy.samples_lights() {
         return l;
     }
-    let Some(ls) = scene.area_lights.sample(&scene.geometry, hit.geom.p, frame.z, strategy, u_choice, u) else { return l };
+    let Some(ls) = scene.area_lights.sample(&scene.geometry, &scene.textures, hit.geom.p, frame.z, strategy, u_choice, u) else { return l };
     if ls.pdf <= 0.0 || !same_side(ls.wi) {
         return l;
     }

@@ -21,7 +21,7 @@ pub(super) fn radiance(scene: &Scene, ray: &Ray, depth: u32, sampler: &mut Pixel
     };
     let wo = -ray.dir.normalize();
     let g = &hit.geom;
-    let le = scene.geometry.emitted(hit.prim, g, wo);
+    let le = scene.emitted(&hit, wo);
     if depth + 1 > scene.settings.max_depth {
         return le;
     }

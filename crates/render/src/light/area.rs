@@ -11,6 +11,7 @@ use raylab_core::color::luminance;
 use raylab_core::{sampling, Frame, Rgb, Vec2, Vec3};
 
 use crate::shape::{Geometry, PrimRef};
+use crate::texture::Texture;
 
 /// How direct light from area lights is estimated (`[render] light_sampling`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -141,16 +142,19 @@ impl AreaLights {
 
     /// Samples light arriving at `p` (shading normal `n`, used by `cells`) from one
     /// emitter. `u_choice` picks the emitter, `u` the point on it.
-    pub fn sample(&self, geometry: &Geometry, p: Vec3, n: Vec3, strategy: LightSampling, u_choice: f32, u: Vec2) -> Option<AreaSample> {
+    pub fn sample(&self, geometry: &Geometry, textures: &[Texture], p: Vec3, n: Vec3, strategy: LightSampling, u_choice: f32, u: Vec2) -> Option<AreaSample> {
         let k = self.cdf.partition_point(|&c| c <= u_choice).min(self.prims.len().checked_sub(1)?);
         let prim = self.prims[k];
         let choice = self.choice[prim as usize];
         let le = geometry.emission(prim);
+        // Emission at texture coordinates `uv` of this emitter.
+        let tex = geometry.emission_texture(prim).map(|t| &textures[t.0 as usize]);
+        let le_at = |uv: Vec2, q: Vec3| tex.map_or(le, |t| le * t.eval(uv, q));
         if strategy == LightSampling::Cells {
             if let Some(quad) = self.parallelograms.iter().find(|q| q.prims.contains(&prim)) {
                 // Either triangle's choice leads here: the quad's probability is their sum.
                 let choice = quad.prims.iter().map(|&t| self.choice[t as usize]).sum::<f32>();
-                return sample_cells(quad, p, n, le, choice, u_choice_rescaled(u_choice, &self.cdf, k), u);
+                return sample_cells(quad, p, n, &le_at, choice, u_choice_rescaled(u_choice, &self.cdf, k), u);
             }
         }
         match geometry.prim(prim) {
@@ -160,7 +164,7 @@ impl AreaLights {
                 let d = c - p;
                 let dc2 = d.length_squared();
                 if dc2 <= r * r {
-                    return self.sample_area(geometry, prim, p, le, choice, u);
+                    return self.sample_area(geometry, prim, p, &le_at, choice, u);
                 }
                 // Cone sampling (pbrt-v4 `Sphere::Sample`): uniform within the cap of
                 // directions that hit the sphere, then the point the direction hits.
@@ -189,26 +193,27 @@ impl AreaLights {
                 }
                 Some(AreaSample { wi: to / dist, dist, le, pdf: choice / (2.0 * PI * one_minus_cos_max) })
             }
-            _ => self.sample_area(geometry, prim, p, le, choice, u),
+            _ => self.sample_area(geometry, prim, p, &le_at, choice, u),
         }
     }
 
     /// Uniform area sampling of emitter `prim`, converted to solid angle.
-    fn sample_area(&self, geometry: &Geometry, prim: u32, p: Vec3, le: Rgb, choice: f32, u: Vec2) -> Option<AreaSample> {
-        let (q, n) = match geometry.prim(prim) {
+    fn sample_area(&self, geometry: &Geometry, prim: u32, p: Vec3, le_at: &dyn Fn(Vec2, Vec3) -> Rgb, choice: f32, u: Vec2) -> Option<AreaSample> {
+        let (q, n, uv) = match geometry.prim(prim) {
             PrimRef::Triangle { mesh, tri } => {
                 let m = &geometry.meshes[mesh as usize];
                 let [a, b, c] = m.vertices(tri);
                 let (b0, b1) = sampling::uniform_triangle(u);
-                (b0 * a + b1 * b + (1.0 - b0 - b1) * c, m.winding_normal(tri))
+                let b2 = 1.0 - b0 - b1;
+                (b0 * a + b1 * b + b2 * c, m.winding_normal(tri), geometry.triangle_uv(prim, b1, b2))
             }
             PrimRef::Sphere(s) => {
                 let sphere = &geometry.spheres[s as usize];
                 let n = sampling::uniform_sphere(u);
-                (sphere.to_world.point(sphere.center) + sphere.radius * n, n)
+                (sphere.to_world.point(sphere.center) + sphere.radius * n, n, Vec2::ZERO)
             }
         };
-        towards(p, q, n, le, choice / area(geometry, prim))
+        towards(p, q, n, le_at(uv, q), choice / area(geometry, prim))
     }
 
     /// Solid-angle density with which `sample` would pick direction `wi` from `p` towards
@@ -267,16 +272,17 @@ fn find_parallelograms(geometry: &Geometry) -> Vec<Parallelogram> {
 
 /// The `cells` strategy on one parallelogram: cell weights are the unshadowed irradiance
 /// from each cell's centre, `max(0, n·ω) · max(0, n_l·-ω) / d²`, mixed with a uniform share.
-fn sample_cells(quad: &Parallelogram, p: Vec3, n: Vec3, le: Rgb, choice: f32, u_cell: f32, u: Vec2) -> Option<AreaSample> {
+fn sample_cells(quad: &Parallelogram, p: Vec3, n: Vec3, le_at: &dyn Fn(Vec2, Vec3) -> Rgb, choice: f32, u_cell: f32, u: Vec2) -> Option<AreaSample> {
     let k = CELLS as usize;
     let mut weights = [0.0f32; (CELLS * CELLS) as usize];
     let mut total = 0.0;
     for (idx, w) in weights.iter_mut().enumerate() {
-        let centre = quad.corner + ((idx % k) as f32 + 0.5) / k as f32 * quad.e1 + ((idx / k) as f32 + 0.5) / k as f32 * quad.e2;
+        let st = Vec2::new(((idx % k) as f32 + 0.5) / k as f32, ((idx / k) as f32 + 0.5) / k as f32);
+        let centre = quad.corner + st.x * quad.e1 + st.y * quad.e2;
         let d = centre - p;
         let d2 = d.length_squared();
         let wi = d / d2.sqrt();
-        *w = n.dot(wi).max(0.0) * quad.normal.dot(-wi).max(0.0) / d2;
+        *w = n.dot(wi).max(0.0) * quad.normal.dot(-wi).max(0.0) / d2 * luminance(le_at(st, centre)).max(0.0);
         total += *w;
     }
     let cells = weights.len() as f32;
@@ -295,7 +301,8 @@ fn sample_cells(quad: &Parallelogram, p: Vec3, n: Vec3, le: Rgb, choice: f32, u_
     let st = (cell + u) / k as f32;
     let q = quad.corner + st.x * quad.e1 + st.y * quad.e2;
     let area = quad.e1.cross(quad.e2).length();
-    towards(p, q, quad.normal, le, choice * prob(weights[chosen]) * cells / area)
+    // The rect's UVs run (0,0), (1,0), (1,1), (0,1) around its corners: `st` itself.
+    towards(p, q, quad.normal, le_at(st, q), choice * prob(weights[chosen]) * cells / area)
 }
 
 /// The sample of light point `q` (normal `n`) from `p`, its area density `pdf_area`

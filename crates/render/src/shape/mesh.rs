@@ -1,7 +1,7 @@
 use raylab_core::{intersect, Aabb, Ray, Rgb, Vec2, Vec3};
 
 use super::SurfaceGeometry;
-use crate::material::MaterialId;
+use crate::material::{MaterialId, TextureId};
 
 /// A triangle mesh in world space (transforms are applied when it is loaded), with
 /// optional per-vertex normals and texture coordinates sharing the position indices.
@@ -18,6 +18,8 @@ pub struct TriangleMesh {
     /// Radiance emitted on the side of the winding normal `(p1 - p0) × (p2 - p0)`, zero for
     /// surfaces that do not emit (pbrt's one-sided diffuse area light).
     pub emission: Rgb,
+    /// A texture scaling `emission` by the surface's UVs (the third report's window light).
+    pub emission_texture: Option<TextureId>,
 }
 
 impl TriangleMesh {

@@ -12,7 +12,7 @@ pub use sphere::Sphere;
 use raylab_accel::{PrimHit, Primitives};
 use raylab_core::{Aabb, Ray, Rgb, Vec2, Vec3};
 
-use crate::material::MaterialId;
+use crate::material::{MaterialId, TextureId};
 
 /// Local surface data at a hit.
 #[derive(Clone, Copy, Debug)]
@@ -95,7 +95,32 @@ impl Geometry {
         }
     }
 
-    /// Radiance leaving point `geom` of primitive `prim` in direction `w`: emitters are
+    /// The texture scaling the primitive's emission, if any.
+    pub fn emission_texture(&self, prim: u32) -> Option<TextureId> {
+        match self.prims[prim as usize] {
+            PrimRef::Triangle { mesh, .. } => self.meshes[mesh as usize].emission_texture,
+            PrimRef::Sphere(_) => None,
+        }
+    }
+
+    /// Texture coordinates at barycentrics `(b1, b2)` of triangle primitive `prim`
+    /// (`(b1, b2)` itself without vertex UVs).
+    pub fn triangle_uv(&self, prim: u32, b1: f32, b2: f32) -> Vec2 {
+        match self.prims[prim as usize] {
+            PrimRef::Triangle { mesh, tri } => {
+                let m = &self.meshes[mesh as usize];
+                if m.uvs.is_empty() {
+                    return Vec2::new(b1, b2);
+                }
+                let [a, b, c] = m.indices[tri as usize].map(|i| m.uvs[i as usize]);
+                (1.0 - b1 - b2) * a + b1 * b + b2 * c
+            }
+            PrimRef::Sphere(_) => Vec2::ZERO,
+        }
+    }
+
+    /// Radiance leaving point `geom` of primitive `prim` in direction `w`, before any
+    /// emission texture (see `Scene::emitted`): emitters are
     /// one-sided (triangles along their winding normal, spheres outwards).
     pub fn emitted(&self, prim: u32, geom: &SurfaceGeometry, w: Vec3) -> Rgb {
         let le = self.emission(prim);
