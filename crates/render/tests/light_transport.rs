@@ -138,10 +138,13 @@ fn cells_importance_sampling_beats_uniform_under_a_large_close_light() {
         let m = mean(&img.pixels);
         (m, img.pixels.iter().map(|p| (p.y - m).powi(2)).sum::<f32>() / img.pixels.len() as f32)
     };
-    let ((_, vu), (mc, vc)) = (spread(LightSampling::Uniform), spread(LightSampling::Cells));
+    let ((_, vu), (mc, vc), (ms, vs)) = (spread(LightSampling::Uniform), spread(LightSampling::Cells), spread(LightSampling::SolidAngle));
     // Closed form as above with A = B = 5 / 0.3: L = 1.99416.
     assert!((mc - 1.99416).abs() < 0.03 * 1.99416, "cells mean {mc}");
     assert!(vc < 0.25 * vu, "variance: cells {vc}, uniform {vu}");
+    // Spherical-rectangle sampling spreads samples evenly over the solid angle.
+    assert!((ms - 1.99416).abs() < 0.03 * 1.99416, "solid-angle mean {ms}");
+    assert!(vs < 0.25 * vu, "variance: solid angle {vs}, uniform {vu}");
 }
 
 #[test]

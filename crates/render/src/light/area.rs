@@ -10,6 +10,7 @@ use std::str::FromStr;
 use raylab_core::color::luminance;
 use raylab_core::{sampling, Frame, Rgb, Vec2, Vec3};
 
+use super::spherical_rect::{SphericalRect, MIN_SOLID_ANGLE};
 use crate::shape::{Geometry, PrimRef};
 use crate::texture::Texture;
 
@@ -19,7 +20,8 @@ pub enum LightSampling {
     /// Points uniformly distributed over the light's area (the report's area form).
     Uniform,
     /// Points distributed uniformly in the solid angle the light subtends: cones for
-    /// spheres; triangles fall back to area sampling.
+    /// spheres, spherical rectangles for rectangles (Ureña et al. 2013); triangles fall
+    /// back to area sampling.
     SolidAngle,
     /// The third report's importance sampling of parallelogram lights: a `k × k` grid of
     /// cells, one chosen by a discrete CDF over the cells' unshadowed contributions
@@ -98,6 +100,17 @@ struct Parallelogram {
     e1: Vec3,
     e2: Vec3,
     normal: Vec3,
+    /// Right angles at the corners: solid-angle sampling as a spherical rectangle applies.
+    rectangular: bool,
+}
+
+impl Parallelogram {
+    /// The spherical rectangle it subtends from `p`, when it is a rectangle and not too
+    /// small for the parametrisation.
+    fn spherical(&self, p: Vec3) -> Option<SphericalRect> {
+        let r = SphericalRect::new(p, self.corner, self.e1, self.e2);
+        (self.rectangular && r.solid_angle > MIN_SOLID_ANGLE).then_some(r)
+    }
 }
 
 /// The scene's emitting primitives with a power-proportional choice among them.
@@ -150,11 +163,23 @@ impl AreaLights {
         // Emission at texture coordinates `uv` of this emitter.
         let tex = geometry.emission_texture(prim).map(|t| &textures[t.0 as usize]);
         let le_at = |uv: Vec2, q: Vec3| tex.map_or(le, |t| le * t.eval(uv, q));
-        if strategy == LightSampling::Cells {
-            if let Some(quad) = self.parallelograms.iter().find(|q| q.prims.contains(&prim)) {
+        if strategy != LightSampling::Uniform {
+            if let Some(quad) = self.parallelogram(prim) {
                 // Either triangle's choice leads here: the quad's probability is their sum.
                 let choice = quad.prims.iter().map(|&t| self.choice[t as usize]).sum::<f32>();
-                return sample_cells(quad, p, n, &le_at, choice, u_choice_rescaled(u_choice, &self.cdf, k), u);
+                if strategy == LightSampling::Cells {
+                    return sample_cells(quad, p, n, &le_at, choice, u_choice_rescaled(u_choice, &self.cdf, k), u);
+                }
+                if let Some(sr) = quad.spherical(p) {
+                    let q = p + sr.sample(u);
+                    let st = Vec2::new((q - quad.corner).dot(quad.e1) / quad.e1.length_squared(), (q - quad.corner).dot(quad.e2) / quad.e2.length_squared());
+                    let dist = (q - p).length();
+                    let wi = (q - p) / dist;
+                    if !(dist > 0.0) || quad.normal.dot(-wi) <= 0.0 {
+                        return None; // the back of the one-sided light
+                    }
+                    return Some(AreaSample { wi, dist, le: le_at(st, q), pdf: choice / sr.solid_angle });
+                }
             }
         }
         match geometry.prim(prim) {
@@ -234,12 +259,21 @@ impl AreaLights {
                 return choice / (2.0 * PI * one_minus);
             }
         }
+        if let Some(quad) = self.parallelogram(prim).filter(|_| strategy != LightSampling::Uniform) {
+            if let Some(sr) = quad.spherical(p) {
+                return quad.prims.iter().map(|&t| self.choice[t as usize]).sum::<f32>() / sr.solid_angle;
+            }
+        }
         let to = q - p;
         let cos_l = n.dot(-to.normalize_or_zero()).abs();
         if cos_l == 0.0 {
             return 0.0;
         }
         choice / area(geometry, prim) * to.length_squared() / cos_l
+    }
+
+    fn parallelogram(&self, prim: u32) -> Option<&Parallelogram> {
+        self.parallelograms.iter().find(|q| q.prims.contains(&prim))
     }
 }
 
@@ -263,7 +297,9 @@ fn find_parallelograms(geometry: &Geometry) -> Vec<Parallelogram> {
             let [a, b, c, d] = [m.positions[0], m.positions[1], m.positions[2], m.positions[3]];
             let scale = (b - a).length().max((d - a).length());
             if ((a + c) - (b + d)).length() <= 1e-5 * scale {
-                out.push(Parallelogram { prims: [prim, prim + 1], corner: a, e1: b - a, e2: d - a, normal: m.winding_normal(0) });
+                let (e1, e2) = (b - a, d - a);
+                let rectangular = e1.dot(e2).abs() <= 1e-5 * e1.length() * e2.length();
+                out.push(Parallelogram { prims: [prim, prim + 1], corner: a, e1, e2, normal: m.winding_normal(0), rectangular });
             }
         }
     }

@@ -2,6 +2,7 @@
 //! ambient term, and area lights (`area.rs`): emitting geometry.
 
 mod area;
+mod spherical_rect;
 
 pub use area::{AreaLights, AreaSample, LightSampling};
 
