@@ -6,6 +6,7 @@ use std::path::Path;
 use raylab_accel::{AccelKind, BuildOptions};
 use raylab_core::{Rgb, Transform, Vec2, Vec3};
 use raylab_render::bsdf::{Distribution, Geometry as MicrofacetGeometry};
+use raylab_render::filter::PixelFilter;
 use raylab_render::light::LightSampling;
 use raylab_render::material::TexColor;
 use raylab_render::shape::Sphere;
@@ -29,6 +30,7 @@ pub struct Overrides {
     pub light_sampling: Option<LightSampling>,
     pub accel: Option<AccelKind>,
     pub seed: Option<u64>,
+    pub filter: Option<PixelFilter>,
 }
 
 impl Overrides {
@@ -43,12 +45,13 @@ impl Overrides {
         s.light_sampling = self.light_sampling.unwrap_or(s.light_sampling);
         s.accel = self.accel.unwrap_or(s.accel);
         s.seed = self.seed.unwrap_or(s.seed);
+        s.filter = self.filter.unwrap_or(s.filter);
     }
 }
 
 const TOP: &[&str] = &["camera", "render", "background", "textures", "materials", "shapes", "lights"];
 const CAMERA: &[&str] = &["from", "at", "up", "vfov", "width", "height", "aperture", "focus_distance"];
-const RENDER: &[&str] = &["spp", "sampler", "max_depth", "integrator", "light_sampling", "accel", "seed"];
+const RENDER: &[&str] = &["spp", "sampler", "max_depth", "integrator", "light_sampling", "accel", "seed", "filter"];
 const BACKGROUND: &[&str] = &["color", "texture"];
 const TEXTURE: &[&str] = &["name", "type", "file", "wrap", "filter", "srgb", "scale", "even", "odd", "space", "kind", "colors", "octaves", "seed", "color"];
 const MATERIAL: &[&str] = &[
@@ -161,6 +164,9 @@ impl Builder<'_> {
             }
             if let Some(v) = r.get("accel") {
                 s.accel = v.str()?.parse().map_err(|e: raylab_accel::UnknownAccel| v.err(e.to_string()))?;
+            }
+            if let Some(v) = r.get("filter") {
+                s.filter = v.str()?.parse().map_err(|e: String| v.err(e))?;
             }
             if let Some(v) = r.get("seed") {
                 s.seed = in_range(&v, v.integer()?, 0, i64::MAX)? as u64;

@@ -4,6 +4,7 @@
 
 pub mod bsdf;
 pub mod camera;
+pub mod filter;
 pub mod integrator;
 pub mod light;
 pub mod material;

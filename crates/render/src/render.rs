@@ -72,14 +72,14 @@ pub fn render(scene: &Scene, progress: &(dyn Fn(u64) + Sync)) -> RenderOutput {
     RenderOutput { width: w, height: h, pixels, counters, nonfinite_samples: nonfinite, seconds }
 }
 
-/// The box-filtered mean of the pixel's samples.
+/// The mean of the pixel's samples, their film positions drawn from the pixel filter.
 fn render_pixel(scene: &Scene, x: u32, y: u32, c: &mut Counters, bad: &mut u64) -> Rgb {
     let s = &scene.settings;
     let inv = Vec2::new(1.0 / s.width as f32, 1.0 / s.height as f32);
     let mut sum = Rgb::ZERO;
     for i in 0..s.spp {
         let mut sampler = PixelSampler::new(s.sampler, s.spp, s.seed, x, y, i);
-        let film = (Vec2::new(x as f32, y as f32) + sampler.pixel_2d()) * inv;
+        let film = (Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + s.filter.offset(sampler.pixel_2d())) * inv;
         let ray = scene.camera.ray(film, sampler.get_2d());
         let l = s.integrator.radiance(scene, &ray, &mut sampler, c);
         if l.is_finite() {

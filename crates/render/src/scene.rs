@@ -2,6 +2,7 @@ use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Primitive
 use raylab_core::{offset_ray_origin, Ray, Rgb, Vec3};
 
 use crate::camera::Camera;
+use crate::filter::PixelFilter;
 use crate::integrator::kind::IntegratorKind;
 use crate::light::{AreaLights, Light, LightSampling};
 use crate::material::{Material, MaterialId, TextureId};
@@ -32,11 +33,13 @@ pub struct RenderSettings {
     pub light_sampling: LightSampling,
     pub accel: AccelKind,
     pub seed: u64,
+    /// Pixel reconstruction filter.
+    pub filter: PixelFilter,
 }
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { width: 640, height: 480, spp: 4, sampler: SamplerKind::Jittered, max_depth: 8, integrator: IntegratorKind::Whitted, light_sampling: LightSampling::Mis, accel: AccelKind::Bvh, seed: 0 }
+        Self { width: 640, height: 480, spp: 4, sampler: SamplerKind::Jittered, max_depth: 8, integrator: IntegratorKind::Whitted, light_sampling: LightSampling::Mis, accel: AccelKind::Bvh, seed: 0, filter: PixelFilter::Box }
     }
 }
 

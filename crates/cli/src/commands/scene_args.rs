@@ -6,6 +6,7 @@ use anyhow::Result;
 use clap::Args;
 use raylab_accel::AccelKind;
 use raylab_loader::Overrides;
+use raylab_render::filter::PixelFilter;
 use raylab_render::light::LightSampling;
 use raylab_render::{IntegratorKind, SamplerKind, Scene};
 
@@ -45,6 +46,9 @@ pub struct SettingsArgs {
     /// Acceleration structure (none, bvh, ...; see `raylab inspect --help`)
     #[arg(long)]
     pub accel: Option<String>,
+    /// Pixel filter: box, tent or gaussian
+    #[arg(long)]
+    pub filter: Option<String>,
     /// Seed of the per-pixel random streams
     #[arg(long)]
     pub seed: Option<u64>,
@@ -65,6 +69,7 @@ impl SettingsArgs {
             integrator: self.integrator.as_ref().map(|s| s.parse::<IntegratorKind>().map_err(|e| anyhow::anyhow!("--integrator: {e}"))).transpose()?,
             accel: self.accel.as_ref().map(parse_accel).transpose()?,
             seed: self.seed,
+            filter: self.filter.as_ref().map(|s| s.parse::<PixelFilter>().map_err(|e| anyhow::anyhow!("--filter: {e}"))).transpose()?,
             ..Overrides::default()
         })
     }

@@ -1,0 +1,112 @@
+//! Pixel reconstruction filters, applied by filter importance sampling (pbrt-v4 §8.8): each
+//! sample's film offset is drawn from the filter itself, so every sample has weight 1 and a
+//! pixel is the plain mean of its samples. The box filter is the pixel's square.
+
+use std::fmt;
+use std::str::FromStr;
+use std::sync::OnceLock;
+
+use raylab_core::Vec2;
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PixelFilter {
+    /// Uniform over the pixel's square (radius ½).
+    #[default]
+    Box,
+    /// Separable tent of radius 1 pixel: `(1 - |x|)(1 - |y|)`.
+    Tent,
+    /// Separable Gaussian, σ = 0.5 pixel, truncated at radius 1.5 pixels.
+    Gaussian,
+}
+
+const GAUSSIAN_SIGMA: f32 = 0.5;
+const GAUSSIAN_RADIUS: f32 = 1.5;
+
+impl PixelFilter {
+    pub const ALL: &'static [PixelFilter] = &[PixelFilter::Box, PixelFilter::Tent, PixelFilter::Gaussian];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            PixelFilter::Box => "box",
+            PixelFilter::Tent => "tent",
+            PixelFilter::Gaussian => "gaussian",
+        }
+    }
+
+    /// The film offset from the pixel's centre for a uniform sample `u` in `[0,1)²`.
+    pub fn offset(self, u: Vec2) -> Vec2 {
+        match self {
+            PixelFilter::Box => u - Vec2::splat(0.5),
+            PixelFilter::Tent => Vec2::new(tent(u.x), tent(u.y)),
+            PixelFilter::Gaussian => Vec2::new(gaussian(u.x), gaussian(u.y)),
+        }
+    }
+}
+
+/// Inverse CDF of the tent `1 - |x|` on [-1, 1].
+fn tent(u: f32) -> f32 {
+    if u < 0.5 { (2.0 * u).sqrt() - 1.0 } else { 1.0 - (2.0 - 2.0 * u).max(0.0).sqrt() }
+}
+
+/// Inverse CDF of the truncated Gaussian, by a table of its CDF (no closed form).
+fn gaussian(u: f32) -> f32 {
+    const N: usize = 1024;
+    static CDF: OnceLock<Vec<f32>> = OnceLock::new();
+    let cdf = CDF.get_or_init(|| {
+        let f = |x: f32| (-x * x / (2.0 * GAUSSIAN_SIGMA * GAUSSIAN_SIGMA)).exp();
+        let dx = 2.0 * GAUSSIAN_RADIUS / N as f32;
+        let mut acc = vec![0.0f32; N + 1];
+        for i in 0..N {
+            let x = -GAUSSIAN_RADIUS + (i as f32 + 0.5) * dx;
+            acc[i + 1] = acc[i] + f(x) * dx;
+        }
+        let total = acc[N];
+        acc.iter().map(|a| a / total).collect()
+    });
+    // The bin holding u, then linear inside it (the density is piecewise constant).
+    let i = cdf.partition_point(|&c| c <= u).clamp(1, N) - 1;
+    let t = (u - cdf[i]) / (cdf[i + 1] - cdf[i]).max(f32::MIN_POSITIVE);
+    -GAUSSIAN_RADIUS + (i as f32 + t.clamp(0.0, 1.0)) * (2.0 * GAUSSIAN_RADIUS / N as f32)
+}
+
+impl fmt::Display for PixelFilter {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for PixelFilter {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let names: Vec<&str> = Self::ALL.iter().map(|f| f.name()).collect();
+        Self::ALL.iter().copied().find(|f| f.name() == s).ok_or_else(|| format!("unknown pixel filter `{s}` (valid: {})", names.join(", ")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Mean and variance of the offsets along x over a fine grid of `u`.
+    fn moments(f: PixelFilter) -> (f64, f64, f32) {
+        let n = 100_000;
+        let xs: Vec<f32> = (0..n).map(|i| f.offset(Vec2::new((i as f32 + 0.5) / n as f32, 0.5)).x).collect();
+        let mean = xs.iter().map(|&x| x as f64).sum::<f64>() / n as f64;
+        let var = xs.iter().map(|&x| (x as f64 - mean).powi(2)).sum::<f64>() / n as f64;
+        (mean, var, xs.iter().fold(0.0f32, |m, &x| m.max(x.abs())))
+    }
+
+    #[test]
+    fn offsets_follow_the_filters() {
+        // Box: uniform on [-½, ½], variance 1/12. Tent of radius 1: variance 1/6.
+        let (m, v, r) = moments(PixelFilter::Box);
+        assert!(m.abs() < 1e-6 && (v - 1.0 / 12.0).abs() < 1e-4 && r <= 0.5, "{m} {v} {r}");
+        let (m, v, r) = moments(PixelFilter::Tent);
+        assert!(m.abs() < 1e-6 && (v - 1.0 / 6.0).abs() < 1e-4 && r <= 1.0, "{m} {v} {r}");
+        // Gaussian σ = ½ truncated at 3σ: variance σ²(1 - 6φ(3)/(2Φ(3) - 1)) = 0.24324.
+        let (m, v, r) = moments(PixelFilter::Gaussian);
+        assert!(m.abs() < 1e-5 && (v - 0.243_24).abs() < 1e-3 && r <= 1.5, "{m} {v} {r}");
+        assert_eq!("tent".parse::<PixelFilter>().unwrap(), PixelFilter::Tent);
+        assert_eq!("mitchell".parse::<PixelFilter>().unwrap_err(), "unknown pixel filter `mitchell` (valid: box, tent, gaussian)");
+    }
+}
