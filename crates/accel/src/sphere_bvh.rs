@@ -9,7 +9,7 @@
 use rayon::prelude::*;
 use raylab_core::{Aabb, BoundingSphere, Ray, Vec3};
 
-use crate::bvh::traverse::{any_in_tree, closest_in_tree, TreeNode};
+use crate::bvh::traverse::{any_in_tree, closest_in_tree, tree_stats, TreeNode};
 use crate::bvh::{lbvh, ploc, SahCost};
 use crate::{robust_margin, Accel, AccelStats, BuildOptions, Counters, Hit, Primitives, ValidationError};
 
@@ -134,23 +134,8 @@ impl Accel for SphereBvh {
             memory_bytes: self.nodes.len() * std::mem::size_of::<SphereNode>() + self.indices.len() * 4,
             ..Default::default()
         };
-        let Some(root) = self.nodes.first() else { return s };
-        // Surface-area cost with sphere areas (∝ r²) relative to the root sphere.
-        let root_area = (root.radius as f64).powi(2).max(f64::MIN_POSITIVE);
-        let mut cost = 0.0;
-        self.visit(|i, depth| {
-            let n = &self.nodes[i];
-            let rel = (n.radius as f64).powi(2) / root_area;
-            s.max_depth = s.max_depth.max(depth);
-            if n.is_leaf() {
-                s.add_leaf(n.count as usize);
-                cost += rel * n.count as f64;
-            } else {
-                s.interior_nodes += 1;
-                cost += rel;
-            }
-        });
-        s.sah_cost = cost;
+        // Surface-area cost with sphere areas (∝ r²).
+        tree_stats(&self.nodes, &mut s, |n| (n.radius as f64).powi(2));
         s
     }
 

@@ -90,27 +90,7 @@ impl Bvh {
             memory_bytes: self.nodes.len() * std::mem::size_of::<BvhNode>() + self.indices.len() * 4,
             ..Default::default()
         };
-        if self.nodes.is_empty() {
-            return s;
-        }
-        let root_area = self.nodes[0].bounds().half_area().max(f32::MIN_POSITIVE) as f64;
-        let mut stack = vec![(0usize, 1usize)];
-        let mut cost = 0.0f64;
-        while let Some((i, depth)) = stack.pop() {
-            let n = &self.nodes[i];
-            let rel = n.bounds().half_area() as f64 / root_area;
-            s.max_depth = s.max_depth.max(depth);
-            if n.is_leaf() {
-                s.add_leaf(n.count as usize);
-                cost += rel * n.count as f64;
-            } else {
-                s.interior_nodes += 1;
-                cost += rel;
-                stack.push((n.left_first as usize, depth + 1));
-                stack.push((n.left_first as usize + 1, depth + 1));
-            }
-        }
-        s.sah_cost = cost;
+        traverse::tree_stats(&self.nodes, &mut s, |n| n.bounds().half_area() as f64);
         s
     }
 

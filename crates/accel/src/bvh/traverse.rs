@@ -132,3 +132,27 @@ pub(crate) fn walk_tree<N: TreeNode>(nodes: &[N], ray: &mut Ray, c: &mut Counter
         }
     }
 }
+
+/// Shape statistics of a tree (depth, leaves, interior nodes) and its SAH cost, with node
+/// areas from `area` taken relative to the root's.
+pub(crate) fn tree_stats<N: TreeNode>(nodes: &[N], s: &mut AccelStats, area: impl Fn(&N) -> f64) {
+    let Some(root) = nodes.first() else { return };
+    let root_area = area(root).max(f64::MIN_POSITIVE);
+    let mut stack = vec![(0usize, 1usize)];
+    let mut cost = 0.0f64;
+    while let Some((i, depth)) = stack.pop() {
+        let n = &nodes[i];
+        let rel = area(n) / root_area;
+        s.max_depth = s.max_depth.max(depth);
+        if n.is_leaf() {
+            s.add_leaf(n.count());
+            cost += rel * n.count() as f64;
+        } else {
+            s.interior_nodes += 1;
+            cost += rel;
+            stack.push((n.left_first(), depth + 1));
+            stack.push((n.left_first() + 1, depth + 1));
+        }
+    }
+    s.sah_cost = cost;
+}
