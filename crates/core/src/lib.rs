@@ -4,6 +4,7 @@
 
 pub mod bounds;
 pub mod color;
+pub mod distribution;
 pub mod frame;
 pub mod intersect;
 pub mod offset;
@@ -13,6 +14,7 @@ pub mod sampling;
 pub mod transform;
 
 pub use bounds::{Aabb, BoundingSphere};
+pub use distribution::{Distribution1D, Distribution2D};
 pub use frame::Frame;
 pub use glam::{Vec2, Vec3};
 pub use offset::{gamma, offset_ray_origin};

@@ -7,7 +7,7 @@ use raylab_accel::{AccelKind, BuildOptions};
 use raylab_core::{Rgb, Transform, Vec2, Vec3};
 use raylab_render::bsdf::{Distribution, Geometry as MicrofacetGeometry};
 use raylab_render::filter::PixelFilter;
-use raylab_render::light::LightSampling;
+use raylab_render::light::{EnvironmentLight, LightSampling};
 use raylab_render::material::TexColor;
 use raylab_render::shape::Sphere;
 use raylab_render::texture::{Checker, CheckerSpace, Filter, ImageTexture, Noise, NoiseKind, Wrap};
@@ -58,7 +58,7 @@ const MATERIAL: &[&str] = &[
     "name", "type", "albedo", "ka", "kd", "ks", "exponent", "reflectance", "ior", "diffuse", "specular", "roughness", "distribution", "geometry", "f0",
 ];
 const SHAPE: &[&str] = &["type", "material", "transform", "center", "radius", "vertices", "normals", "uvs", "file", "smooth"];
-const LIGHT: &[&str] = &["type", "position", "intensity", "direction", "irradiance", "vertices", "radiance", "texture", "center", "radius", "n"];
+const LIGHT: &[&str] = &["type", "position", "intensity", "direction", "irradiance", "vertices", "radiance", "texture", "center", "radius", "n", "file", "scale"];
 const TRANSFORM_STEP: &[&str] = &["scale", "rotate", "translate"];
 const ROTATE: &[&str] = &["axis", "degrees"];
 
@@ -74,7 +74,7 @@ pub fn load_scene_str(src: &str, path: &Path, resolver: &Resolver, overrides: &O
     let doc = Doc::new(path, src);
     let root = doc.parse(src)?;
     let top = Table::new(&doc, String::new(), root.span(), root.get_ref(), TOP)?;
-    let mut b = Builder { doc: &doc, resolver, texture_ids: HashMap::new(), material_ids: HashMap::new(), mtl_cache: HashMap::new() };
+    let mut b = Builder { doc: &doc, resolver, texture_ids: HashMap::new(), material_ids: HashMap::new(), mtl_cache: HashMap::new(), has_background: top.has("background") };
 
     let settings = b.settings(&top, overrides)?;
     let camera = b.camera(&top, &settings)?;
@@ -105,6 +105,8 @@ struct Builder<'a> {
     material_ids: HashMap<String, MaterialId>,
     /// MTL materials already converted, by (MTL path, index).
     mtl_cache: HashMap<(String, usize), MaterialId>,
+    /// Whether the scene has a `[background]` table (an environment light replaces it).
+    has_background: bool,
 }
 
 fn positive(v: &Val, x: f32) -> Result<f32, LoadError> {
@@ -506,13 +508,14 @@ impl Builder<'_> {
     }
 
     fn light(&mut self, scene: &mut Scene, t: &Table) -> Result<(), LoadError> {
-        let kind = t.type_name(&["point", "directional", "ambient", "grid", "rect", "sphere"])?;
+        let kind = t.type_name(&["point", "directional", "ambient", "grid", "rect", "sphere", "environment"])?;
         let valid: &[&str] = match kind {
             "point" => &["position", "intensity"],
             "directional" => &["direction", "irradiance"],
             "grid" => &["vertices", "n", "intensity"],
             "rect" => &["vertices", "radiance", "texture"],
             "sphere" => &["center", "radius", "radiance"],
+            "environment" => &["file", "scale"],
             _ => &["intensity"],
         };
         for k in LIGHT {
@@ -534,6 +537,7 @@ impl Builder<'_> {
                 let n = in_range(&nv, nv.integer()?, 1, 64)? as u32;
                 Light::Grid { corner, edge_u, edge_v, n, intensity: t.req("intensity")?.color()? }
             }
+            "environment" => return self.environment_light(scene, t),
             _ => return self.area_light(scene, kind, t),
         };
         scene.lights.push(light);
@@ -557,6 +561,24 @@ impl Builder<'_> {
     fn parallelogram(&self, t: &Table) -> Result<[Vec3; 3], LoadError> {
         let v = self.quad_vertices(t)?;
         Ok([v[0], v[1] - v[0], v[3] - v[0]])
+    }
+
+    /// An equirectangular image (PNG, EXR, ...) around the scene, importance sampled; it is
+    /// the background too.
+    fn environment_light(&mut self, scene: &mut Scene, t: &Table) -> Result<(), LoadError> {
+        let tv = t.req("type")?;
+        if self.has_background {
+            return Err(tv.err("an environment light is the scene's background: remove `[background]`"));
+        }
+        if scene.environment.is_some() {
+            return Err(tv.err("only one environment light is allowed"));
+        }
+        let scale = t.opt("scale", |v| v.color())?.unwrap_or(Rgb::ONE);
+        let fv = t.req("file")?;
+        let found = self.find(&fv)?;
+        let image = self.image_texture(&fv, &found, true, Wrap::Repeat, Filter::Bilinear)?;
+        scene.environment = Some(EnvironmentLight::new(image, scale));
+        Ok(())
     }
 
     /// Area lights are geometry that emits and reflects nothing (a black material).

@@ -118,3 +118,12 @@ fn example_scenes_and_default_scene_parse() {
     assert_eq!(d.geometry.triangle_count(), 4968 + 2);
     assert_eq!(d.geometry.spheres.len(), 2);
 }
+
+#[test]
+fn environment_light_errors() {
+    let env = "[[lights]]\ntype = \"environment\"\nfile = \"no_such_sky.exr\"\n";
+    assert_eq!(error_of(&format!("{CAMERA}[background]\ncolor = 0.1\n{env}")), "bad.toml:8: lights[0].type: an environment light is the scene's background: remove `[background]`");
+    assert!(error_of(&format!("{CAMERA}{env}")).starts_with("bad.toml:7: lights[0].file: cannot find `no_such_sky.exr` (looked in "));
+    assert_eq!(error_of(&format!("{CAMERA}{env}scale = -2\n")), "bad.toml:8: lights[0].scale: colour components must not be negative, found [-2, -2, -2]");
+    assert_eq!(error_of(&format!("{CAMERA}{env}radius = 2\n")), "bad.toml:8: lights[0].radius: not a field of `environment` lights (valid: type, file, scale)");
+}

@@ -4,7 +4,7 @@ use raylab_core::{offset_ray_origin, Ray, Rgb, Vec3};
 use crate::camera::Camera;
 use crate::filter::PixelFilter;
 use crate::integrator::kind::IntegratorKind;
-use crate::light::{AreaLights, Light, LightSampling};
+use crate::light::{AreaLights, EnvironmentLight, Light, LightSampling};
 use crate::material::{Material, MaterialId, TextureId};
 use crate::sampler::SamplerKind;
 use crate::shape::{Geometry, SurfaceGeometry};
@@ -79,6 +79,8 @@ pub struct Scene {
     pub texture_names: Vec<String>,
     pub lights: Vec<Light>,
     pub background: Background,
+    /// An importance-sampled environment map; when present it is the background.
+    pub environment: Option<EnvironmentLight>,
     /// The emitting primitives, rebuilt with the acceleration structure.
     pub area_lights: AreaLights,
     accel: AnyAccel,
@@ -99,6 +101,7 @@ impl Scene {
             texture_names: Vec::new(),
             lights: Vec::new(),
             background: Background::Color(Rgb::ZERO),
+            environment: None,
             area_lights: AreaLights::default(),
             accel,
         }
@@ -137,6 +140,9 @@ impl Scene {
     }
 
     pub fn background(&self, dir: Vec3) -> Rgb {
+        if let Some(env) = &self.environment {
+            return env.radiance(dir);
+        }
         match self.background {
             Background::Color(c) => c,
             Background::Texture(t) => self.textures[t.0 as usize].eval(equirect_uv(dir.normalize()), dir),

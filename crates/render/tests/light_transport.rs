@@ -174,3 +174,50 @@ fn textured_rect_lights_scale_their_radiance_by_the_texture() {
         assert!((l - reference).abs() < 0.03 * reference, "{strategy}: {l} against uniform {reference}");
     }
 }
+
+/// The Lambertian floor (ρ = 0.5) seen straight down, lit only by an environment map.
+fn environment_scene(image: raylab_render::texture::ImageTexture, strategy: LightSampling, spp: u32) -> Scene {
+    let camera = Camera::new(Vec3::new(0.0, 1.0, 0.0), Vec3::ZERO, Vec3::Z, 1.0, 1.0, 0.0, None).unwrap();
+    let settings = RenderSettings { width: 8, height: 8, spp, sampler: SamplerKind::Sobol, integrator: IntegratorKind::Direct, light_sampling: strategy, max_depth: 2, ..Default::default() };
+    let mut scene = Scene::new(camera, settings);
+    let m = scene.add_material("floor", Material::Diffuse { albedo: TexColor::Constant(Rgb::splat(0.5)) });
+    scene.geometry.add_mesh(floor(m, 50.0));
+    scene.environment = Some(raylab_render::light::EnvironmentLight::new(image, Rgb::ONE));
+    scene.build_accel(&BuildOptions::default());
+    scene
+}
+
+fn env_image(w: u32, h: u32, texel: impl Fn(u32, u32) -> Rgb) -> raylab_render::texture::ImageTexture {
+    use raylab_render::texture::{Filter, ImageTexture, Wrap};
+    let texels = (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| texel(x, y)).collect();
+    ImageTexture::new(w, h, texels, Wrap::Repeat, Filter::Bilinear).unwrap()
+}
+
+#[test]
+fn every_strategy_sees_albedo_times_a_constant_environment() {
+    // Under uniform radiance L from the whole sky, L_o = ρ/π · L · π = ρ L = 1.
+    for strategy in [LightSampling::Uniform, LightSampling::Cells, LightSampling::Bsdf, LightSampling::Mis] {
+        let img = render(&environment_scene(env_image(16, 8, |_, _| Rgb::splat(2.0)), strategy, 64), &|_| {});
+        let l = mean(&img.pixels);
+        assert!((l - 1.0).abs() < 0.01, "{strategy}: {l}");
+    }
+}
+
+#[test]
+fn environment_importance_sampling_agrees_with_bsdf_sampling_and_beats_it_under_a_sun() {
+    // A dim sky and a 2×2-texel sun high above the floor.
+    let sun = |x: u32, y: u32| if (10..12).contains(&x) && (3..5).contains(&y) { Rgb::splat(500.0) } else { Rgb::splat(0.2) };
+    let stats = |strategy, spp| {
+        let img = render(&environment_scene(env_image(32, 16, sun), strategy, spp), &|_| {});
+        let m = mean(&img.pixels);
+        (m, img.pixels.iter().map(|p| (p.y - m).powi(2)).sum::<f32>() / img.pixels.len() as f32)
+    };
+    let (reference, _) = stats(LightSampling::Bsdf, 1024);
+    let (_, bsdf_var) = stats(LightSampling::Bsdf, 64);
+    for strategy in [LightSampling::Uniform, LightSampling::Mis] {
+        let (m, var) = stats(strategy, 64);
+        assert!((m - reference).abs() < 0.03 * reference, "{strategy}: {m}, bsdf sampling at 1024 spp: {reference}");
+        // Per-pixel spread at equal sample counts.
+        assert!(var * 10.0 < bsdf_var, "{strategy}: variance {var}, bsdf {bsdf_var}");
+    }
+}

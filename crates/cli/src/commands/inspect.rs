@@ -143,6 +143,7 @@ fn report(name: String, scene: &Scene) -> Report {
         textures: scene.texture_names.clone(),
         lights: scene.lights.iter().enumerate().map(|(i, l)| NamedKind { name: format!("light {i}"), kind: describe_light(l) }).collect(),
         background: match scene.background {
+            _ if scene.environment.is_some() => "environment light (importance sampled)".into(),
             Background::Color(c) => format!("colour [{}, {}, {}]", c.x, c.y, c.z),
             Background::Texture(t) => format!("texture {}", scene.texture_names[t.0 as usize]),
         },

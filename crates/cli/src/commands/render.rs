@@ -108,7 +108,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
                 g.len(),
                 g.triangle_count(),
                 g.spheres.len(),
-                scene.lights.len() + scene.area_lights.len(),
+                scene.lights.len() + scene.area_lights.len() + scene.environment.is_some() as usize,
                 stats.name,
                 stats.build_ms,
                 load_s,

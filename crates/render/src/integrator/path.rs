@@ -4,8 +4,9 @@
 //!
 //! `max_depth` counts path segments from the camera: 1 shows only emitters seen directly,
 //! 2 adds direct lighting, and so on. Delta lights (point, directional) are always sampled;
-//! area lights by the scene's `light_sampling` strategy; the background is radiance from
-//! infinity found by BSDF sampling.
+//! area lights by the scene's `light_sampling` strategy. A plain background is radiance from
+//! infinity found by BSDF sampling; an environment light is also sampled by luminance (every
+//! strategy but `bsdf`) and weighted against BSDF sampling under `mis`.
 
 use raylab_accel::Counters;
 use raylab_core::{Frame, Ray, Rgb, Vec2, Vec3};
@@ -66,7 +67,7 @@ pub(super) fn radiance(scene: &Scene, camera_ray: &Ray, sampler: &mut PixelSampl
     let mut prev_p = ray.origin;
     for depth in 1..=s.max_depth {
         let Some(hit) = scene.intersect(&ray, c) else {
-            l += beta * scene.background(ray.dir);
+            l += beta * scene.background(ray.dir) * environment_weight(scene, specular, prev_pdf, ray.dir);
             break;
         };
         let wo = -ray.dir.normalize();
@@ -120,6 +121,24 @@ pub(super) fn radiance(scene: &Scene, camera_ray: &Ray, sampler: &mut PixelSampl
     l
 }
 
+/// The share of background radiance found by BSDF sampling: all of it without an environment
+/// light or after a specular bounce; under MIS the power heuristic against environment
+/// sampling; none under the other light-sampling strategies, whose environment samples
+/// already counted it.
+fn environment_weight(scene: &Scene, specular: bool, prev_pdf: f32, dir: Vec3) -> f32 {
+    let strategy = scene.settings.light_sampling;
+    match &scene.environment {
+        Some(env) if !specular && strategy.samples_lights() => {
+            if strategy == LightSampling::Mis {
+                power_heuristic(prev_pdf, env.pdf(dir.normalize()))
+            } else {
+                0.0
+            }
+        }
+        _ => 1.0,
+    }
+}
+
 /// Direct light at a non-specular hit: every delta light, plus one area-light sample and,
 /// for MIS, the BSDF sample's share is added when that path hits the emitter.
 fn direct_light(scene: &Scene, hit: &SurfaceHit, bsdf: &Bsdf, frame: &Frame, wo: Vec3, sampler: &mut PixelSampler, c: &mut Counters) -> Rgb {
@@ -143,6 +162,17 @@ fn direct_light(scene: &Scene, hit: &SurfaceHit, bsdf: &Bsdf, frame: &Frame, wo:
         }
     }
     let strategy = scene.settings.light_sampling;
+    if let Some(env) = &scene.environment {
+        let u = sampler.get_2d();
+        if let Some(es) = env.sample(u).filter(|es| strategy.samples_lights() && same_side(es.wi)) {
+            let wi_local = frame.to_local(es.wi);
+            let f = bsdf.eval(wo_local, wi_local);
+            if f != Rgb::ZERO && !scene.occluded(&hit.spawn_to(es.wi, f32::INFINITY), c) {
+                let weight = if strategy == LightSampling::Mis { power_heuristic(es.pdf, bsdf.pdf(wo_local, wi_local)) } else { 1.0 };
+                l += f * es.le * (wi_local.z.abs() * weight / es.pdf);
+            }
+        }
+    }
     let (u_choice, u) = (sampler.get_1d(), sampler.get_2d());
     if scene.area_lights.is_empty() || !strategy.samples_lights() {
         return l;

@@ -1,10 +1,13 @@
 //! Delta lights (point and directional, invisible to camera rays), the Phong model's constant
-//! ambient term, and area lights (`area.rs`): emitting geometry.
+//! ambient term, area lights (`area.rs`): emitting geometry, and the importance-sampled
+//! environment map (`environment.rs`).
 
 mod area;
+mod environment;
 mod spherical_rect;
 
 pub use area::{AreaLights, AreaSample, LightSampling};
+pub use environment::{EnvironmentLight, EnvironmentSample};
 
 use raylab_core::{sampling, Rgb, Vec2, Vec3};
 

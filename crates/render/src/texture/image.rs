@@ -173,6 +173,11 @@ impl ImageTexture {
         self.height
     }
 
+    /// The texels, row-major, row 0 at the top.
+    pub fn texels(&self) -> &[Rgb] {
+        &self.texels
+    }
+
     /// Mean colour of all texels (ignores `scale` and `wrap`, which do not change it).
     pub fn average(&self) -> Rgb {
         self.average
