@@ -7,7 +7,7 @@ use raylab_accel::{AccelKind, BuildOptions};
 use raylab_core::{Rgb, Transform, Vec2, Vec3};
 use raylab_render::bsdf::{Distribution, Geometry as MicrofacetGeometry};
 use raylab_render::filter::PixelFilter;
-use raylab_render::light::{EnvironmentLight, LightSampling};
+use raylab_render::light::{EnvironmentLight, LightSampling, MAX_CELLS};
 use raylab_render::material::TexColor;
 use raylab_render::shape::Sphere;
 use raylab_render::texture::{Checker, CheckerSpace, Filter, ImageTexture, Noise, NoiseKind, Wrap};
@@ -28,6 +28,7 @@ pub struct Overrides {
     pub sampler: Option<SamplerKind>,
     pub integrator: Option<IntegratorKind>,
     pub light_sampling: Option<LightSampling>,
+    pub light_cells: Option<u32>,
     pub accel: Option<AccelKind>,
     pub seed: Option<u64>,
     pub filter: Option<PixelFilter>,
@@ -43,6 +44,7 @@ impl Overrides {
         s.sampler = self.sampler.unwrap_or(s.sampler);
         s.integrator = self.integrator.unwrap_or(s.integrator);
         s.light_sampling = self.light_sampling.unwrap_or(s.light_sampling);
+        s.light_cells = self.light_cells.unwrap_or(s.light_cells);
         s.accel = self.accel.unwrap_or(s.accel);
         s.seed = self.seed.unwrap_or(s.seed);
         s.filter = self.filter.unwrap_or(s.filter);
@@ -51,7 +53,7 @@ impl Overrides {
 
 const TOP: &[&str] = &["camera", "render", "background", "textures", "materials", "shapes", "lights"];
 const CAMERA: &[&str] = &["from", "at", "up", "vfov", "width", "height", "aperture", "focus_distance"];
-const RENDER: &[&str] = &["spp", "sampler", "max_depth", "integrator", "light_sampling", "accel", "seed", "filter"];
+const RENDER: &[&str] = &["spp", "sampler", "max_depth", "integrator", "light_sampling", "light_cells", "accel", "seed", "filter"];
 const BACKGROUND: &[&str] = &["color", "texture"];
 const TEXTURE: &[&str] = &["name", "type", "file", "wrap", "filter", "srgb", "scale", "even", "odd", "space", "kind", "colors", "octaves", "seed", "color"];
 const MATERIAL: &[&str] = &[
@@ -163,6 +165,9 @@ impl Builder<'_> {
             }
             if let Some(v) = r.get("light_sampling") {
                 s.light_sampling = v.str()?.parse().map_err(|e: String| v.err(e))?;
+            }
+            if let Some(v) = r.get("light_cells") {
+                s.light_cells = in_range(&v, v.integer()?, 1, MAX_CELLS as i64)? as u32;
             }
             if let Some(v) = r.get("accel") {
                 s.accel = v.str()?.parse().map_err(|e: raylab_accel::UnknownAccel| v.err(e.to_string()))?;

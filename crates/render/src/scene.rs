@@ -31,6 +31,8 @@ pub struct RenderSettings {
     pub integrator: IntegratorKind,
     /// How `direct` and `path` sample area lights.
     pub light_sampling: LightSampling,
+    /// Cells per side of the `cells` strategy's grid (read by [`Scene::build_accel`]).
+    pub light_cells: u32,
     pub accel: AccelKind,
     pub seed: u64,
     /// Pixel reconstruction filter.
@@ -39,7 +41,7 @@ pub struct RenderSettings {
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { width: 640, height: 480, spp: 4, sampler: SamplerKind::Jittered, max_depth: 8, integrator: IntegratorKind::Whitted, light_sampling: LightSampling::Mis, accel: AccelKind::Bvh, seed: 0, filter: PixelFilter::Box }
+        Self { width: 640, height: 480, spp: 4, sampler: SamplerKind::Jittered, max_depth: 8, integrator: IntegratorKind::Whitted, light_sampling: LightSampling::Mis, light_cells: crate::light::DEFAULT_CELLS, accel: AccelKind::Bvh, seed: 0, filter: PixelFilter::Box }
     }
 }
 
@@ -111,7 +113,7 @@ impl Scene {
     /// changes.
     pub fn build_accel(&mut self, opts: &BuildOptions) {
         self.accel = AnyAccel::build(self.settings.accel, &self.geometry, opts);
-        self.area_lights = AreaLights::new(&self.geometry);
+        self.area_lights = AreaLights::new(&self.geometry, self.settings.light_cells);
     }
 
     pub fn accel(&self) -> &AnyAccel {

@@ -148,6 +148,31 @@ fn cells_importance_sampling_beats_uniform_under_a_large_close_light() {
 }
 
 #[test]
+fn finer_cell_grids_stay_unbiased_and_cut_variance_under_a_large_close_light() {
+    // The report's experiment with the number of light partitions: 1 cell is uniform area
+    // sampling; more cells follow the irradiance better.
+    let spread = |k| {
+        let mut scene = rect_light_scene(LightSampling::Cells, 5.0, 0.3, 16);
+        scene.settings.light_cells = k;
+        scene.build_accel(&BuildOptions::default());
+        let img = render(&scene, &|_| {});
+        let m = mean(&img.pixels);
+        (m, img.pixels.iter().map(|p| (p.y - m).powi(2)).sum::<f32>() / img.pixels.len() as f32)
+    };
+    let variances: Vec<f32> = [1, 4, 16]
+        .into_iter()
+        .map(|k| {
+            let (m, v) = spread(k);
+            // Unbiased: within four standard errors of the mean of 64 independent pixels.
+            let se = (v / 64.0).sqrt();
+            assert!((m - 1.99416).abs() < 4.0 * se + 0.005, "{k}×{k} cells: mean {m} ± {se}");
+            v
+        })
+        .collect();
+    assert!(variances[1] < 0.5 * variances[0] && variances[2] < 0.5 * variances[1], "variance by grid 1, 4, 16: {variances:?}");
+}
+
+#[test]
 fn textured_rect_lights_scale_their_radiance_by_the_texture() {
     use raylab_render::texture::{Checker, CheckerSpace, Texture};
     // A constant texture of 0.5 halves the closed form of the 1×1 light above (0.146956).

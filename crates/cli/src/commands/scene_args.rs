@@ -49,6 +49,9 @@ pub struct SettingsArgs {
     /// Pixel filter: box, tent or gaussian
     #[arg(long)]
     pub filter: Option<String>,
+    /// Cells per side of the `cells` light-sampling grid (1 to 16; default 8)
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16))]
+    pub light_cells: Option<u32>,
     /// Seed of the per-pixel random streams
     #[arg(long)]
     pub seed: Option<u64>,
@@ -69,6 +72,7 @@ impl SettingsArgs {
             integrator: self.integrator.as_ref().map(|s| s.parse::<IntegratorKind>().map_err(|e| anyhow::anyhow!("--integrator: {e}"))).transpose()?,
             accel: self.accel.as_ref().map(parse_accel).transpose()?,
             seed: self.seed,
+            light_cells: self.light_cells,
             filter: self.filter.as_ref().map(|s| s.parse::<PixelFilter>().map_err(|e| anyhow::anyhow!("--filter: {e}"))).transpose()?,
             ..Overrides::default()
         })

@@ -83,8 +83,9 @@ pub struct AreaSample {
     pub pdf: f32,
 }
 
-/// Cells per side of the `cells` strategy's grid.
-pub const CELLS: u32 = 8;
+/// Cells per side of the `cells` strategy's grid: the default and the largest allowed.
+pub const DEFAULT_CELLS: u32 = 8;
+pub const MAX_CELLS: u32 = 16;
 
 /// Share of the `cells` strategy's choice spread uniformly over all cells: a cell whose
 /// centre sees no light may still light the point in part (defensive sampling, Hesterberg
@@ -122,10 +123,14 @@ pub struct AreaLights {
     cdf: Vec<f32>,
     /// Probability of choosing each emitter, indexed by primitive (0 for non-emitters).
     choice: Vec<f32>,
+    /// Cells per side of the `cells` strategy's grid (1 to [`MAX_CELLS`]).
+    cells: u32,
 }
 
 impl AreaLights {
-    pub fn new(geometry: &Geometry) -> Self {
+    /// The emitters of `geometry`; `cells` per side for the `cells` strategy (clamped to
+    /// 1..=[`MAX_CELLS`]).
+    pub fn new(geometry: &Geometry, cells: u32) -> Self {
         use raylab_accel::Primitives;
         let n = geometry.len() as u32;
         let prims: Vec<u32> = (0..n).filter(|&p| geometry.emission(p) != Rgb::ZERO).collect();
@@ -142,7 +147,7 @@ impl AreaLights {
         if let Some(last) = cdf.last_mut() {
             *last = 1.0;
         }
-        Self { parallelograms: find_parallelograms(geometry), prims, cdf, choice }
+        Self { parallelograms: find_parallelograms(geometry), prims, cdf, choice, cells: cells.clamp(1, MAX_CELLS) }
     }
 
     pub fn is_empty(&self) -> bool {
@@ -168,7 +173,7 @@ impl AreaLights {
                 // Either triangle's choice leads here: the quad's probability is their sum.
                 let choice = quad.prims.iter().map(|&t| self.choice[t as usize]).sum::<f32>();
                 if strategy == LightSampling::Cells {
-                    return sample_cells(quad, p, n, &le_at, choice, u_choice_rescaled(u_choice, &self.cdf, k), u);
+                    return sample_cells(quad, self.cells, p, n, &le_at, choice, u_choice_rescaled(u_choice, &self.cdf, k), u);
                 }
                 if let Some(sr) = quad.spherical(p) {
                     let q = p + sr.sample(u);
@@ -308,9 +313,10 @@ fn find_parallelograms(geometry: &Geometry) -> Vec<Parallelogram> {
 
 /// The `cells` strategy on one parallelogram: cell weights are the unshadowed irradiance
 /// from each cell's centre, `max(0, n·ω) · max(0, n_l·-ω) / d²`, mixed with a uniform share.
-fn sample_cells(quad: &Parallelogram, p: Vec3, n: Vec3, le_at: &dyn Fn(Vec2, Vec3) -> Rgb, choice: f32, u_cell: f32, u: Vec2) -> Option<AreaSample> {
-    let k = CELLS as usize;
-    let mut weights = [0.0f32; (CELLS * CELLS) as usize];
+fn sample_cells(quad: &Parallelogram, k: u32, p: Vec3, n: Vec3, le_at: &dyn Fn(Vec2, Vec3) -> Rgb, choice: f32, u_cell: f32, u: Vec2) -> Option<AreaSample> {
+    let k = k as usize;
+    let mut storage = [0.0f32; (MAX_CELLS * MAX_CELLS) as usize];
+    let weights = &mut storage[..k * k];
     let mut total = 0.0;
     for (idx, w) in weights.iter_mut().enumerate() {
         let st = Vec2::new(((idx % k) as f32 + 0.5) / k as f32, ((idx / k) as f32 + 0.5) / k as f32);

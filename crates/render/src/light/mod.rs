@@ -6,7 +6,7 @@ mod area;
 mod environment;
 mod spherical_rect;
 
-pub use area::{AreaLights, AreaSample, LightSampling};
+pub use area::{AreaLights, AreaSample, LightSampling, DEFAULT_CELLS, MAX_CELLS};
 pub use environment::{EnvironmentLight, EnvironmentSample};
 
 use raylab_core::{sampling, Rgb, Vec2, Vec3};
