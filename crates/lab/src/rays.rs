@@ -88,7 +88,7 @@ pub fn generate(scene: &Scene, width: u32, height: u32, kinds: &[RayKind], seed:
                 }
                 _ => scene
                     .area_lights
-                    .sample(&scene.geometry, &scene.textures, hit.geom.p, n, LightSampling::Uniform, rng.next_f32(), rng.next_vec2())
+                    .sample(&scene.geometry, &scene.textures, hit.geom.p, &|_| 1.0, LightSampling::Uniform, rng.next_f32(), rng.next_vec2())
                     .map(|s| hit.spawn_to(s.wi, s.dist)),
             };
             (Some(diffuse), shadow)

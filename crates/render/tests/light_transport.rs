@@ -246,3 +246,20 @@ fn environment_importance_sampling_agrees_with_bsdf_sampling_and_beats_it_under_
         assert!(var * 10.0 < bsdf_var, "{strategy}: variance {var}, bsdf {bsdf_var}");
     }
 }
+
+#[test]
+fn cells_follow_the_receiver_and_keep_a_defensive_share_elsewhere() {
+    // A receiver that reflects only light arriving from +x: cells on the −x half get only
+    // their part of the 10 % uniform share, 0.1 × 32/64 = 5 % of the samples.
+    let scene = rect_light_scene(LightSampling::Cells, 0.5, 2.0, 1);
+    let receiver = |wi: Vec3| if wi.x > 0.0 { 1.0 } else { 0.0 };
+    let mut rng = raylab_core::Pcg32::new(5, 0);
+    let n = 40_000;
+    let mut left = 0;
+    for _ in 0..n {
+        let s = scene.area_lights.sample(&scene.geometry, &scene.textures, Vec3::ZERO, &receiver, LightSampling::Cells, rng.next_f32(), rng.next_vec2()).unwrap();
+        left += usize::from(s.wi.x < 0.0);
+    }
+    let share = left as f32 / n as f32;
+    assert!((share - 0.05).abs() < 0.006, "share of samples from the −x half: {share}");
+}

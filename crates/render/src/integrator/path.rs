@@ -9,6 +9,7 @@
 //! strategy but `bsdf`) and weighted against BSDF sampling under `mis`.
 
 use raylab_accel::Counters;
+use raylab_core::color::luminance;
 use raylab_core::{Frame, Ray, Rgb, Vec2, Vec3};
 
 use crate::bsdf::Bsdf;
@@ -177,7 +178,11 @@ fn direct_light(scene: &Scene, hit: &SurfaceHit, bsdf: &Bsdf, frame: &Frame, wo:
     if scene.area_lights.is_empty() || !strategy.samples_lights() {
         return l;
     }
-    let Some(ls) = scene.area_lights.sample(&scene.geometry, &scene.textures, hit.geom.p, frame.z, strategy, u_choice, u) else { return l };
+    let receiver = |wi: Vec3| {
+        let wi_local = frame.to_local(wi);
+        luminance(bsdf.eval(wo_local, wi_local)) * wi_local.z.abs()
+    };
+    let Some(ls) = scene.area_lights.sample(&scene.geometry, &scene.textures, hit.geom.p, &receiver, strategy, u_choice, u) else { return l };
     if ls.pdf <= 0.0 || !same_side(ls.wi) {
         return l;
     }

@@ -92,6 +92,11 @@ pub const MAX_CELLS: u32 = 16;
 /// 1995), so every cell keeps a non-zero probability and the estimate stays unbiased.
 const CELLS_UNIFORM_SHARE: f32 = 0.1;
 
+/// How much the receiving point turns light from world direction `wi` towards the viewer:
+/// the luminance of `f(wo, wi) · |cos θi|`. The `cells` strategy weighs cells by it (the
+/// report's importance `G · (f_diffuse + f_specular)`); the other strategies ignore it.
+pub type Receiver<'a> = &'a dyn Fn(Vec3) -> f32;
+
 /// An emitting mesh that is one parallelogram (two triangles `[0, 1, 2]`, `[0, 2, 3]`):
 /// sampled as a whole by the `cells` strategy.
 #[derive(Clone, Copy, Debug)]
@@ -158,9 +163,9 @@ impl AreaLights {
         self.prims.len()
     }
 
-    /// Samples light arriving at `p` (shading normal `n`, used by `cells`) from one
-    /// emitter. `u_choice` picks the emitter, `u` the point on it.
-    pub fn sample(&self, geometry: &Geometry, textures: &[Texture], p: Vec3, n: Vec3, strategy: LightSampling, u_choice: f32, u: Vec2) -> Option<AreaSample> {
+    /// Samples light arriving at `p` from one emitter (`receiver` weighs the `cells`).
+    /// `u_choice` picks the emitter, `u` the point on it.
+    pub fn sample(&self, geometry: &Geometry, textures: &[Texture], p: Vec3, receiver: Receiver, strategy: LightSampling, u_choice: f32, u: Vec2) -> Option<AreaSample> {
         let k = self.cdf.partition_point(|&c| c <= u_choice).min(self.prims.len().checked_sub(1)?);
         let prim = self.prims[k];
         let choice = self.choice[prim as usize];
@@ -173,7 +178,7 @@ impl AreaLights {
                 // Either triangle's choice leads here: the quad's probability is their sum.
                 let choice = quad.prims.iter().map(|&t| self.choice[t as usize]).sum::<f32>();
                 if strategy == LightSampling::Cells {
-                    return sample_cells(quad, self.cells, p, n, &le_at, choice, u_choice_rescaled(u_choice, &self.cdf, k), u);
+                    return sample_cells(quad, self.cells, p, receiver, &le_at, choice, u_choice_rescaled(u_choice, &self.cdf, k), u);
                 }
                 if let Some(sr) = quad.spherical(p) {
                     let q = p + sr.sample(u);
@@ -311,9 +316,10 @@ fn find_parallelograms(geometry: &Geometry) -> Vec<Parallelogram> {
     out
 }
 
-/// The `cells` strategy on one parallelogram: cell weights are the unshadowed irradiance
-/// from each cell's centre, `max(0, n·ω) · max(0, n_l·-ω) / d²`, mixed with a uniform share.
-fn sample_cells(quad: &Parallelogram, k: u32, p: Vec3, n: Vec3, le_at: &dyn Fn(Vec2, Vec3) -> Rgb, choice: f32, u_cell: f32, u: Vec2) -> Option<AreaSample> {
+/// The `cells` strategy on one parallelogram: cell weights are the unshadowed light the
+/// point reflects from each cell's centre, `receiver(ω) · max(0, n_l·-ω) / d² · lum(Le)`,
+/// mixed with a uniform share.
+fn sample_cells(quad: &Parallelogram, k: u32, p: Vec3, receiver: Receiver, le_at: &dyn Fn(Vec2, Vec3) -> Rgb, choice: f32, u_cell: f32, u: Vec2) -> Option<AreaSample> {
     let k = k as usize;
     let mut storage = [0.0f32; (MAX_CELLS * MAX_CELLS) as usize];
     let weights = &mut storage[..k * k];
@@ -324,7 +330,8 @@ fn sample_cells(quad: &Parallelogram, k: u32, p: Vec3, n: Vec3, le_at: &dyn Fn(V
         let d = centre - p;
         let d2 = d.length_squared();
         let wi = d / d2.sqrt();
-        *w = n.dot(wi).max(0.0) * quad.normal.dot(-wi).max(0.0) / d2 * luminance(le_at(st, centre)).max(0.0);
+        let facing = quad.normal.dot(-wi).max(0.0);
+        *w = if facing > 0.0 { receiver(wi).max(0.0) * facing / d2 * luminance(le_at(st, centre)).max(0.0) } else { 0.0 };
         total += *w;
     }
     let cells = weights.len() as f32;
