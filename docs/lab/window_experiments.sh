@@ -3,7 +3,7 @@
 # window standing on a glossy floor). Usage, from the repository root after
 # `cargo build --release`: docs/lab/window_experiments.sh [OUT]   (default /tmp/window_exp)
 #   1. the floor's specular lobe: Phong exponent 100, 500, 2000 and three Cook-Torrance
-#      (f0, m) of the report, rendered with the report's 36 cells -> OUT/materials/*.png;
+#      (f0, m) of the report, rendered with MIS -> OUT/materials/*.png;
 #   2. convergence of uniform, cells (6×6), solid-angle and mis without shadows, and
 #   3. with two spheres casting shadows on the reflection (the report's second scene);
 #   4. the number of cells k×k at 16 spp against the reference of 2.
@@ -30,7 +30,7 @@ open(out, "w").write(s + extra)
 PY
 }
 
-echo "## 1. Floor materials (200×200, 64 spp, cells 6×6)"
+echo "## 1. Floor materials (200×200, 64 spp, mis)"
 echo "| floor | render s |"
 echo "|---|---:|"
 for spec in "phong_e100|type = \"phong\"
@@ -63,7 +63,7 @@ f0 = 0.03
 roughness = 0.01"; do
   name=${spec%%|*}
   variant "$OUT/$name.toml" "${spec#*|}"
-  t=$($R render "$OUT/$name.toml" --width 200 --height 200 --spp 64 -q --json -o "$OUT/materials/$name.png" | python3 -c 'import json,sys; print(round(json.load(sys.stdin)["render_seconds"], 2))')
+  t=$($R render "$OUT/$name.toml" --width 200 --height 200 --spp 64 --light-sampling mis -q --json -o "$OUT/materials/$name.png" | python3 -c 'import json,sys; print(round(json.load(sys.stdin)["render_seconds"], 2))')
   echo "| $name | $t |"
 done
 
