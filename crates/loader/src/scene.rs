@@ -8,7 +8,7 @@ use raylab_core::{Rgb, Transform, Vec2, Vec3};
 use raylab_render::bsdf::{Distribution, Geometry as MicrofacetGeometry};
 use raylab_render::filter::PixelFilter;
 use raylab_render::light::{EnvironmentLight, LightSampling, MAX_CELLS};
-use raylab_render::material::TexColor;
+use raylab_render::material::{TexColor, METALS};
 use raylab_render::shape::Sphere;
 use raylab_render::texture::{Checker, CheckerSpace, Filter, ImageTexture, Noise, NoiseKind, Wrap};
 use raylab_render::{Background, Camera, IntegratorKind, Light, Material, MaterialId, RenderSettings, SamplerKind, Scene, Texture, TriangleMesh};
@@ -57,7 +57,7 @@ const RENDER: &[&str] = &["spp", "sampler", "max_depth", "integrator", "light_sa
 const BACKGROUND: &[&str] = &["color", "texture"];
 const TEXTURE: &[&str] = &["name", "type", "file", "wrap", "filter", "srgb", "scale", "even", "odd", "space", "kind", "colors", "octaves", "seed", "color"];
 const MATERIAL: &[&str] = &[
-    "name", "type", "albedo", "ka", "kd", "ks", "exponent", "reflectance", "ior", "diffuse", "specular", "roughness", "distribution", "geometry", "f0",
+    "name", "type", "albedo", "ka", "kd", "ks", "exponent", "reflectance", "ior", "diffuse", "specular", "roughness", "distribution", "geometry", "f0", "metal", "eta", "k",
 ];
 const SHAPE: &[&str] = &["type", "material", "transform", "center", "radius", "vertices", "normals", "uvs", "file", "smooth"];
 const LIGHT: &[&str] = &["type", "position", "intensity", "direction", "irradiance", "vertices", "radiance", "texture", "center", "radius", "n", "file", "scale"];
@@ -303,12 +303,13 @@ impl Builder<'_> {
         if self.material_ids.contains_key(&name) {
             return Err(name_v.err(format!("a material named `{name}` already exists")));
         }
-        let kind = t.type_name(&["diffuse", "phong", "mirror", "dielectric", "cooktorrance"])?;
+        let kind = t.type_name(&["diffuse", "phong", "mirror", "dielectric", "cooktorrance", "conductor"])?;
         let valid: &[&str] = match kind {
             "diffuse" => &["albedo"],
             "phong" => &["ka", "kd", "ks", "exponent"],
             "mirror" => &["reflectance"],
             "cooktorrance" => &["diffuse", "specular", "roughness", "distribution", "geometry", "f0"],
+            "conductor" => &["metal", "eta", "k", "roughness", "distribution", "geometry"],
             _ => &["ior"],
         };
         for k in MATERIAL {
@@ -317,6 +318,9 @@ impl Builder<'_> {
             }
         }
         let color = |key: &str, default: Rgb| -> Result<TexColor, LoadError> { t.get(key).map(|v| self.tex_color(&v)).transpose().map(|c| c.unwrap_or(TexColor::Constant(default))) };
+        let roughness = || t.opt("roughness", |v| in_range_f32(v, v.f32()?, 1e-3, 10.0));
+        let distribution = || t.opt("distribution", |v| v.str()?.parse::<Distribution>().map_err(|e| v.err(e.to_string())));
+        let geometry = || t.opt("geometry", |v| v.str()?.parse::<MicrofacetGeometry>().map_err(|e| v.err(e.to_string())));
         let m = match kind {
             "diffuse" => Material::Diffuse { albedo: color("albedo", Rgb::splat(0.5))? },
             "phong" => Material::Phong {
@@ -337,16 +341,42 @@ impl Builder<'_> {
             "cooktorrance" => Material::CookTorrance {
                 diffuse: color("diffuse", Rgb::ZERO)?,
                 specular: color("specular", Rgb::ONE)?,
-                roughness: t.opt("roughness", |v| in_range_f32(v, v.f32()?, 1e-3, 10.0))?.unwrap_or(0.2),
-                distribution: t.opt("distribution", |v| v.str()?.parse::<Distribution>().map_err(|e| v.err(e.to_string())))?.unwrap_or(Distribution::Ggx),
-                geometry: t.opt("geometry", |v| v.str()?.parse::<MicrofacetGeometry>().map_err(|e| v.err(e.to_string())))?.unwrap_or(MicrofacetGeometry::Smith),
+                roughness: roughness()?.unwrap_or(0.2),
+                distribution: distribution()?.unwrap_or(Distribution::Ggx),
+                geometry: geometry()?.unwrap_or(MicrofacetGeometry::Smith),
                 f0: color("f0", Rgb::splat(0.04))?,
             },
+            "conductor" => {
+                let (eta, k) = self.metal(t)?;
+                Material::Conductor { eta, k, roughness: roughness()?.unwrap_or(0.1), distribution: distribution()?.unwrap_or(Distribution::Ggx), geometry: geometry()?.unwrap_or(MicrofacetGeometry::Smith) }
+            }
             _ => Material::Dielectric { ior: t.opt("ior", |v| positive(v, v.f32()?))?.unwrap_or(1.5) },
         };
         let id = scene.add_material(name.clone(), m);
         self.material_ids.insert(name, id);
         Ok(())
+    }
+
+    /// A conductor's complex index: a named `metal` (default copper) or both `eta` and `k`.
+    fn metal(&self, t: &Table) -> Result<(Rgb, Rgb), LoadError> {
+        match (t.get("metal"), t.get("eta"), t.get("k")) {
+            (Some(_), Some(v), _) | (Some(_), None, Some(v)) => Err(v.err("give either `metal` or `eta` and `k`, not both")),
+            (None, Some(ev), Some(kv)) => {
+                let eta = ev.color()?;
+                if eta.min_element() <= 0.0 {
+                    return Err(ev.err(format!("components must be positive, found [{}, {}, {}]", eta.x, eta.y, eta.z)));
+                }
+                Ok((eta, kv.color()?))
+            }
+            (None, Some(v), None) | (None, None, Some(v)) => Err(v.err("`eta` and `k` go together: give both")),
+            (metal, None, None) => {
+                let name = metal.as_ref().map(|v| v.str()).transpose()?.unwrap_or("copper");
+                let (_, eta, k) = METALS.iter().find(|(n, ..)| *n == name).ok_or_else(|| {
+                    metal.unwrap().err(format!("unknown metal `{name}` (valid: {})", METALS.iter().map(|m| m.0).collect::<Vec<_>>().join(", ")))
+                })?;
+                Ok((Rgb::from_array(*eta), Rgb::from_array(*k)))
+            }
+        }
     }
 
     fn material_ref(&self, t: &Table) -> Result<Option<MaterialId>, LoadError> {

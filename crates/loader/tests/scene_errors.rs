@@ -128,3 +128,13 @@ fn environment_light_errors() {
     assert_eq!(error_of(&format!("{CAMERA}{env}scale = -2\n")), "bad.toml:8: lights[0].scale: colour components must not be negative, found [-2, -2, -2]");
     assert_eq!(error_of(&format!("{CAMERA}{env}radius = 2\n")), "bad.toml:8: lights[0].radius: not a field of `environment` lights (valid: type, file, scale)");
 }
+
+#[test]
+fn conductor_errors() {
+    let m = "[[materials]]\nname = \"m\"\ntype = \"conductor\"\n";
+    assert_eq!(error_of(&format!("{CAMERA}{m}metal = \"tin\"\n")), "bad.toml:8: materials[0].metal: unknown metal `tin` (valid: gold, silver, copper, aluminium)");
+    assert_eq!(error_of(&format!("{CAMERA}{m}metal = \"gold\"\neta = 1\n")), "bad.toml:9: materials[0].eta: give either `metal` or `eta` and `k`, not both");
+    assert_eq!(error_of(&format!("{CAMERA}{m}k = 3\n")), "bad.toml:8: materials[0].k: `eta` and `k` go together: give both");
+    assert_eq!(error_of(&format!("{CAMERA}{m}eta = [0.2, 0, 1]\nk = 3\n")), "bad.toml:8: materials[0].eta: components must be positive, found [0.2, 0, 1]");
+    assert_eq!(error_of(&format!("{CAMERA}{m}roughness = 0\n")), "bad.toml:8: materials[0].roughness: must be between 0.001 and 10, found 0");
+}

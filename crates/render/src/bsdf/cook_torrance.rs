@@ -3,7 +3,8 @@
 //!
 //! `f = diffuse/π + specular · D(h)·G(wo, wi)·F(wo·h) / (4 cos θi cos θo)`, h = (wo+wi)/|wo+wi|,
 //!
-//! D and G from `microfacet.rs`, F Schlick's with `f0` (f0 = 1 gives F ≡ 1). The two terms
+//! D and G from `microfacet.rs`, F Schlick's with `f0` (f0 = 1 gives F ≡ 1) or a conductor's
+//! exact Fresnel (`fresnel.rs`). The two terms
 //! are simply added, as in the original model: energy is conserved only if
 //! `diffuse + specular ≤ 1`. Sampling picks the diffuse lobe (cosine hemisphere) or the
 //! specular one (h with density D(h) cos θh, reflected about h: pdf D cos θh / (4 wo·h),
@@ -14,8 +15,8 @@ use raylab_core::{Rgb, Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 
 use super::lobe_probability;
-use super::microfacet::{schlick, Distribution, Geometry, MIN_ALPHA};
-use super::fresnel::reflect;
+use super::fresnel::{reflect, Fresnel};
+use super::microfacet::{Distribution, Geometry, MIN_ALPHA};
 
 pub(super) struct CookTorrance {
     pub diffuse: Rgb,
@@ -23,7 +24,7 @@ pub(super) struct CookTorrance {
     pub alpha: f32,
     pub distribution: Distribution,
     pub geometry: Geometry,
-    pub f0: Rgb,
+    pub fresnel: Fresnel,
 }
 
 impl CookTorrance {
@@ -36,7 +37,7 @@ impl CookTorrance {
         let alpha = self.alpha();
         let d = self.distribution.d(h, alpha);
         let g = self.geometry.g(self.distribution, alpha, wo, wi, h);
-        self.diffuse * FRAC_1_PI + self.specular * schlick(self.f0, cos_oh) * (d * g / (4.0 * wo.z * wi.z))
+        self.diffuse * FRAC_1_PI + self.specular * self.fresnel.eval(cos_oh) * (d * g / (4.0 * wo.z * wi.z))
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {

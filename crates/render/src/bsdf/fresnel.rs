@@ -1,4 +1,74 @@
-use raylab_core::Vec3;
+use raylab_core::{Rgb, Vec3};
+
+/// The Fresnel term of a microfacet BRDF.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Fresnel {
+    /// Schlick's approximation from the reflectance at normal incidence `f0` (`f0 = 1`: no
+    /// falloff).
+    Schlick(Rgb),
+    /// A conductor's exact unpolarised Fresnel reflectance, complex index `eta + i·k` per
+    /// channel (pbrt-v4's `FrComplex`).
+    Conductor { eta: Rgb, k: Rgb },
+}
+
+impl Fresnel {
+    /// Reflectance at incidence cosine `cos_i` (on the outside, ≥ 0).
+    pub fn eval(&self, cos_i: f32) -> Rgb {
+        match *self {
+            Fresnel::Schlick(f0) => super::microfacet::schlick(f0, cos_i),
+            Fresnel::Conductor { eta, k } => Rgb::new(
+                fresnel_conductor(cos_i, Complex(eta.x, k.x)),
+                fresnel_conductor(cos_i, Complex(eta.y, k.y)),
+                fresnel_conductor(cos_i, Complex(eta.z, k.z)),
+            ),
+        }
+    }
+}
+
+/// Just enough complex arithmetic for the conductor Fresnel equations.
+#[derive(Clone, Copy, Debug)]
+struct Complex(f32, f32);
+
+impl Complex {
+    fn add(self, o: Complex) -> Complex {
+        Complex(self.0 + o.0, self.1 + o.1)
+    }
+    fn sub(self, o: Complex) -> Complex {
+        Complex(self.0 - o.0, self.1 - o.1)
+    }
+    fn mul(self, o: Complex) -> Complex {
+        Complex(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0)
+    }
+    fn scale(self, s: f32) -> Complex {
+        Complex(self.0 * s, self.1 * s)
+    }
+    fn div(self, o: Complex) -> Complex {
+        let d = o.0 * o.0 + o.1 * o.1;
+        Complex((self.0 * o.0 + self.1 * o.1) / d, (self.1 * o.0 - self.0 * o.1) / d)
+    }
+    fn norm(self) -> f32 {
+        self.0 * self.0 + self.1 * self.1
+    }
+    /// Principal square root (non-negative real part).
+    fn sqrt(self) -> Complex {
+        let n = self.norm().sqrt();
+        let re = (0.5 * (n + self.0)).max(0.0).sqrt();
+        let im = (0.5 * (n - self.0)).max(0.0).sqrt();
+        Complex(re, if self.1 < 0.0 { -im } else { im })
+    }
+}
+
+/// Unpolarised Fresnel reflectance of a conductor with complex relative index `eta`, light
+/// arriving at `cos_i` from outside: the dielectric equations with a complex index.
+fn fresnel_conductor(cos_i: f32, eta: Complex) -> f32 {
+    let cos_i = cos_i.clamp(0.0, 1.0);
+    let one = Complex(1.0, 0.0);
+    let sin2_t = Complex(1.0 - cos_i * cos_i, 0.0).div(eta.mul(eta));
+    let cos_t = one.sub(sin2_t).sqrt();
+    let r_parl = eta.scale(cos_i).sub(cos_t).div(eta.scale(cos_i).add(cos_t));
+    let r_perp = Complex(cos_i, 0.0).sub(eta.mul(cos_t)).div(Complex(cos_i, 0.0).add(eta.mul(cos_t)));
+    0.5 * (r_parl.norm() + r_perp.norm())
+}
 
 /// Mirror direction of `wo` (pointing away from the surface) about `n`.
 #[inline]
@@ -56,6 +126,22 @@ mod tests {
         // Beyond the critical angle from inside: total internal reflection.
         let critical = (1.0f32 / 1.5).asin();
         assert_eq!(fresnel_dielectric(-(critical + 0.01).cos(), 1.5), 1.0);
+    }
+
+    #[test]
+    fn conductor_fresnel_known_values() {
+        // Normal incidence: ((η − 1)² + k²) / ((η + 1)² + k²); gold's red channel.
+        let (eta, k) = (0.143f32, 3.983f32);
+        let f0 = ((eta - 1.0).powi(2) + k * k) / ((eta + 1.0).powi(2) + k * k);
+        let gold = Fresnel::Conductor { eta: Rgb::splat(eta), k: Rgb::splat(k) };
+        assert!((gold.eval(1.0).x - f0).abs() < 1e-5, "{} vs {f0}", gold.eval(1.0).x);
+        // Grazing incidence reflects everything.
+        assert!((gold.eval(0.0).x - 1.0).abs() < 1e-5);
+        // Without absorption it is the dielectric's reflectance, at every angle.
+        let glass = Fresnel::Conductor { eta: Rgb::splat(1.5), k: Rgb::ZERO };
+        for c in [1.0f32, 0.8, 0.5, 0.2, 0.05] {
+            assert!((glass.eval(c).x - fresnel_dielectric(c, 1.5)).abs() < 1e-5, "cos {c}");
+        }
     }
 
     #[test]

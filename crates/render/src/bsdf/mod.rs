@@ -22,7 +22,7 @@ mod phong;
 #[cfg(test)]
 mod tests;
 
-pub use fresnel::{fresnel_dielectric, reflect, refract};
+pub use fresnel::{fresnel_dielectric, reflect, refract, Fresnel};
 pub use microfacet::{Distribution, Geometry};
 
 use raylab_core::color::luminance;
@@ -43,7 +43,7 @@ pub enum Bsdf {
     Dielectric { ior: f32 },
     /// Cook–Torrance microfacet reflection plus a Lambertian base, see `cook_torrance.rs`.
     /// `alpha` is the roughness (for Beckmann the RMS slope), clamped to ≥ 1e-3.
-    CookTorrance { diffuse: Rgb, specular: Rgb, alpha: f32, distribution: Distribution, geometry: Geometry, f0: Rgb },
+    CookTorrance { diffuse: Rgb, specular: Rgb, alpha: f32, distribution: Distribution, geometry: Geometry, fresnel: Fresnel },
 }
 
 /// One sampled direction with the BSDF value and density there.
@@ -63,8 +63,8 @@ impl Bsdf {
         match *self {
             Bsdf::Lambert { albedo } => lambert::eval(albedo, wo, wi),
             Bsdf::Phong { kd, ks, exponent } => phong::Phong { kd, ks, exponent }.eval(wo, wi),
-            Bsdf::CookTorrance { diffuse, specular, alpha, distribution, geometry, f0 } => {
-                cook_torrance::CookTorrance { diffuse, specular, alpha, distribution, geometry, f0 }.eval(wo, wi)
+            Bsdf::CookTorrance { diffuse, specular, alpha, distribution, geometry, fresnel } => {
+                cook_torrance::CookTorrance { diffuse, specular, alpha, distribution, geometry, fresnel }.eval(wo, wi)
             }
             Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } => Rgb::ZERO,
         }
@@ -75,8 +75,8 @@ impl Bsdf {
         match *self {
             Bsdf::Lambert { .. } => lambert::pdf(wo, wi),
             Bsdf::Phong { kd, ks, exponent } => phong::Phong { kd, ks, exponent }.pdf(wo, wi),
-            Bsdf::CookTorrance { diffuse, specular, alpha, distribution, geometry, f0 } => {
-                cook_torrance::CookTorrance { diffuse, specular, alpha, distribution, geometry, f0 }.pdf(wo, wi)
+            Bsdf::CookTorrance { diffuse, specular, alpha, distribution, geometry, fresnel } => {
+                cook_torrance::CookTorrance { diffuse, specular, alpha, distribution, geometry, fresnel }.pdf(wo, wi)
             }
             Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } => 0.0,
         }
@@ -89,8 +89,8 @@ impl Bsdf {
         let wi = match *self {
             Bsdf::Lambert { .. } => lambert::sample(wo, u)?,
             Bsdf::Phong { kd, ks, exponent } => phong::Phong { kd, ks, exponent }.sample(wo, u_lobe, u)?,
-            Bsdf::CookTorrance { diffuse, specular, alpha, distribution, geometry, f0 } => {
-                cook_torrance::CookTorrance { diffuse, specular, alpha, distribution, geometry, f0 }.sample(wo, u_lobe, u)?
+            Bsdf::CookTorrance { diffuse, specular, alpha, distribution, geometry, fresnel } => {
+                cook_torrance::CookTorrance { diffuse, specular, alpha, distribution, geometry, fresnel }.sample(wo, u_lobe, u)?
             }
             Bsdf::Mirror { reflectance } => return mirror::sample(reflectance, wo),
             Bsdf::Dielectric { ior } => return dielectric::sample(ior, wo, u_lobe),

@@ -26,7 +26,7 @@ fn close_rgb(a: Rgb, b: Rgb, rel: f32) -> bool {
 }
 
 fn cook_torrance(distribution: Distribution, geometry: Geometry, alpha: f32) -> Bsdf {
-    Bsdf::CookTorrance { diffuse: Rgb::new(0.2, 0.3, 0.1), specular: Rgb::new(0.6, 0.5, 0.7), alpha, distribution, geometry, f0: Rgb::new(0.9, 0.5, 0.04) }
+    Bsdf::CookTorrance { diffuse: Rgb::new(0.2, 0.3, 0.1), specular: Rgb::new(0.6, 0.5, 0.7), alpha, distribution, geometry, fresnel: Fresnel::Schlick(Rgb::new(0.9, 0.5, 0.04)) }
 }
 
 const DISTRIBUTIONS: [Distribution; 2] = [Distribution::Beckmann, Distribution::Ggx];
@@ -47,6 +47,8 @@ fn smooth_models() -> Vec<(String, Bsdf)> {
             }
         }
     }
+    let gold = Fresnel::Conductor { eta: Rgb::new(0.143, 0.374, 1.442), k: Rgb::new(3.983, 2.385, 1.603) };
+    v.push(("conductor gold ggx α=0.2".to_string(), Bsdf::CookTorrance { diffuse: Rgb::ZERO, specular: Rgb::ONE, alpha: 0.2, distribution: Distribution::Ggx, geometry: Geometry::Smith, fresnel: gold }));
     v
 }
 
@@ -274,7 +276,7 @@ fn white_furnace() {
     // Closed form: GGX, α = 1, Smith, normal incidence. D = 1/π, wi = 2θh off the normal,
     // G2 = 2 cos θi / (1 + cos θi): E = 2 ∫₀^{π/4} G2 cos θh sin θh dθh = 1 − ln 2.
     let ggx =
-        Bsdf::CookTorrance { diffuse: Rgb::ZERO, specular: Rgb::ONE, alpha: 1.0, distribution: Distribution::Ggx, geometry: Geometry::Smith, f0: Rgb::ONE };
+        Bsdf::CookTorrance { diffuse: Rgb::ZERO, specular: Rgb::ONE, alpha: 1.0, distribution: Distribution::Ggx, geometry: Geometry::Smith, fresnel: Fresnel::Schlick(Rgb::ONE) };
     let (e, se) = albedo(&ggx, Vec3::Z, 99);
     assert!((e - (1.0 - 2f64.ln())).abs() < 4.0 * se + 1e-3, "GGX α=1 at normal incidence: {e} ± {se}");
     let lambert = Bsdf::Lambert { albedo: Rgb::ONE };
@@ -293,7 +295,7 @@ fn white_furnace() {
         for d in DISTRIBUTIONS {
             for g in GEOMETRIES {
                 for alpha in [0.05, 0.1, 0.3, 0.6, 1.0] {
-                    let b = Bsdf::CookTorrance { diffuse: Rgb::ZERO, specular: Rgb::ONE, alpha, distribution: d, geometry: g, f0: Rgb::ONE };
+                    let b = Bsdf::CookTorrance { diffuse: Rgb::ZERO, specular: Rgb::ONE, alpha, distribution: d, geometry: g, fresnel: Fresnel::Schlick(Rgb::ONE) };
                     let (e, se) = albedo(&b, wo, k as u64);
                     assert!(e <= 1.0 + 4.0 * se + 5e-3, "{d} {g} α={alpha} wo={wo}: {e} ± {se}");
                     if g == Geometry::Smith && alpha <= 0.1 && wo.z >= 0.8 {

@@ -3,7 +3,7 @@
 
 use raylab_core::{Rgb, Vec2, Vec3};
 
-use crate::bsdf::{Bsdf, Distribution, Geometry as MicrofacetGeometry};
+use crate::bsdf::{Bsdf, Distribution, Fresnel, Geometry as MicrofacetGeometry};
 use crate::texture::Texture;
 
 /// Index of a material in [`crate::Scene::materials`]; 0 is the default grey diffuse.
@@ -52,7 +52,19 @@ pub enum Material {
     /// Cook–Torrance microfacet reflection over a Lambertian base (see `crate::bsdf`):
     /// `f = diffuse/π + specular·D·G·F / (4 cos θi cos θo)`, `roughness` = α.
     CookTorrance { diffuse: TexColor, specular: TexColor, roughness: f32, distribution: Distribution, geometry: MicrofacetGeometry, f0: TexColor },
+    /// Rough metal (pbrt-v4's `conductor`): the same microfacet reflection with the exact
+    /// Fresnel reflectance of complex index `eta + i·k` per channel and no diffuse base.
+    Conductor { eta: Rgb, k: Rgb, roughness: f32, distribution: Distribution, geometry: MicrofacetGeometry },
 }
+
+/// Complex refractive indices `(eta, k)` of common metals at the R, G and B primaries
+/// (the usual RGB fits of measured spectra), for `conductor` materials.
+pub const METALS: &[(&str, [f32; 3], [f32; 3])] = &[
+    ("gold", [0.143, 0.374, 1.442], [3.983, 2.385, 1.603]),
+    ("silver", [0.155, 0.117, 0.138], [4.828, 3.122, 2.147]),
+    ("copper", [0.200, 0.924, 1.102], [3.912, 2.452, 2.142]),
+    ("aluminium", [1.657, 0.880, 0.521], [9.224, 6.270, 4.837]),
+];
 
 impl Material {
     /// The physically based BSDF at a surface point (textures looked up at `uv`, `p`). The
@@ -65,7 +77,10 @@ impl Material {
             Material::Mirror { reflectance } => Bsdf::Mirror { reflectance: c(reflectance) },
             Material::Dielectric { ior } => Bsdf::Dielectric { ior: *ior },
             Material::CookTorrance { diffuse, specular, roughness, distribution, geometry, f0 } => {
-                Bsdf::CookTorrance { diffuse: c(diffuse), specular: c(specular), alpha: *roughness, distribution: *distribution, geometry: *geometry, f0: c(f0) }
+                Bsdf::CookTorrance { diffuse: c(diffuse), specular: c(specular), alpha: *roughness, distribution: *distribution, geometry: *geometry, fresnel: Fresnel::Schlick(c(f0)) }
+            }
+            Material::Conductor { eta, k, roughness, distribution, geometry } => {
+                Bsdf::CookTorrance { diffuse: Rgb::ZERO, specular: Rgb::ONE, alpha: *roughness, distribution: *distribution, geometry: *geometry, fresnel: Fresnel::Conductor { eta: *eta, k: *k } }
             }
         }
     }
@@ -79,6 +94,7 @@ impl Material {
             Material::Mirror { reflectance } => c(reflectance),
             Material::Dielectric { .. } => Rgb::ONE,
             Material::CookTorrance { diffuse, specular, .. } => c(diffuse) + c(specular),
+            Material::Conductor { eta, k, .. } => Fresnel::Conductor { eta: *eta, k: *k }.eval(1.0),
         }
     }
 
@@ -93,6 +109,7 @@ impl Material {
             Material::Mirror { .. } => "mirror",
             Material::Dielectric { .. } => "dielectric",
             Material::CookTorrance { .. } => "cooktorrance",
+            Material::Conductor { .. } => "conductor",
         }
     }
 }
