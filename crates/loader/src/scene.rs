@@ -7,6 +7,7 @@ use raylab_accel::{AccelKind, BuildOptions};
 use raylab_core::{Rgb, Transform, Vec2, Vec3};
 use raylab_render::bsdf::{Distribution, Geometry as MicrofacetGeometry};
 use raylab_render::filter::PixelFilter;
+use raylab_render::integrator::MisHeuristic;
 use raylab_render::light::{EnvironmentLight, LightSampling, MAX_CELLS};
 use raylab_render::material::{TexColor, METALS};
 use raylab_render::shape::Sphere;
@@ -29,6 +30,7 @@ pub struct Overrides {
     pub integrator: Option<IntegratorKind>,
     pub light_sampling: Option<LightSampling>,
     pub light_cells: Option<u32>,
+    pub mis_heuristic: Option<MisHeuristic>,
     pub accel: Option<AccelKind>,
     pub seed: Option<u64>,
     pub filter: Option<PixelFilter>,
@@ -45,6 +47,7 @@ impl Overrides {
         s.integrator = self.integrator.unwrap_or(s.integrator);
         s.light_sampling = self.light_sampling.unwrap_or(s.light_sampling);
         s.light_cells = self.light_cells.unwrap_or(s.light_cells);
+        s.mis_heuristic = self.mis_heuristic.unwrap_or(s.mis_heuristic);
         s.accel = self.accel.unwrap_or(s.accel);
         s.seed = self.seed.unwrap_or(s.seed);
         s.filter = self.filter.unwrap_or(s.filter);
@@ -53,7 +56,7 @@ impl Overrides {
 
 const TOP: &[&str] = &["camera", "render", "background", "textures", "materials", "shapes", "lights"];
 const CAMERA: &[&str] = &["from", "at", "up", "vfov", "width", "height", "aperture", "focus_distance"];
-const RENDER: &[&str] = &["spp", "sampler", "max_depth", "integrator", "light_sampling", "light_cells", "accel", "seed", "filter"];
+const RENDER: &[&str] = &["spp", "sampler", "max_depth", "integrator", "light_sampling", "light_cells", "mis_heuristic", "accel", "seed", "filter"];
 const BACKGROUND: &[&str] = &["color", "texture"];
 const TEXTURE: &[&str] = &["name", "type", "file", "wrap", "filter", "srgb", "scale", "even", "odd", "space", "kind", "colors", "octaves", "seed", "color"];
 const MATERIAL: &[&str] = &[
@@ -165,6 +168,9 @@ impl Builder<'_> {
             }
             if let Some(v) = r.get("light_sampling") {
                 s.light_sampling = v.str()?.parse().map_err(|e: String| v.err(e))?;
+            }
+            if let Some(v) = r.get("mis_heuristic") {
+                s.mis_heuristic = v.str()?.parse().map_err(|e: String| v.err(e))?;
             }
             if let Some(v) = r.get("light_cells") {
                 s.light_cells = in_range(&v, v.integer()?, 1, MAX_CELLS as i64)? as u32;

@@ -138,3 +138,8 @@ fn conductor_errors() {
     assert_eq!(error_of(&format!("{CAMERA}{m}eta = [0.2, 0, 1]\nk = 3\n")), "bad.toml:8: materials[0].eta: components must be positive, found [0.2, 0, 1]");
     assert_eq!(error_of(&format!("{CAMERA}{m}roughness = 0\n")), "bad.toml:8: materials[0].roughness: must be between 0.001 and 10, found 0");
 }
+
+#[test]
+fn mis_heuristic_names_the_valid_ones() {
+    assert_eq!(error_of(&format!("{CAMERA}[render]\nmis_heuristic = \"cutoff\"\n")), "bad.toml:6: render.mis_heuristic: unknown MIS heuristic `cutoff` (valid: power, balance)");
+}

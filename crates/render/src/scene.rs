@@ -4,6 +4,7 @@ use raylab_core::{offset_ray_origin, Ray, Rgb, Vec3};
 use crate::camera::Camera;
 use crate::filter::PixelFilter;
 use crate::integrator::kind::IntegratorKind;
+use crate::integrator::MisHeuristic;
 use crate::light::{AreaLights, EnvironmentLight, Light, LightSampling};
 use crate::material::{Material, MaterialId, TextureId};
 use crate::sampler::SamplerKind;
@@ -31,6 +32,8 @@ pub struct RenderSettings {
     pub integrator: IntegratorKind,
     /// How `direct` and `path` sample area lights.
     pub light_sampling: LightSampling,
+    /// How `mis` weighs light and BSDF samples.
+    pub mis_heuristic: MisHeuristic,
     /// Cells per side of the `cells` strategy's grid (read by [`Scene::build_accel`]).
     pub light_cells: u32,
     pub accel: AccelKind,
@@ -41,7 +44,7 @@ pub struct RenderSettings {
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { width: 640, height: 480, spp: 4, sampler: SamplerKind::Jittered, max_depth: 8, integrator: IntegratorKind::Whitted, light_sampling: LightSampling::Mis, light_cells: crate::light::DEFAULT_CELLS, accel: AccelKind::Bvh, seed: 0, filter: PixelFilter::Box }
+        Self { width: 640, height: 480, spp: 4, sampler: SamplerKind::Jittered, max_depth: 8, integrator: IntegratorKind::Whitted, light_sampling: LightSampling::Mis, mis_heuristic: MisHeuristic::Power, light_cells: crate::light::DEFAULT_CELLS, accel: AccelKind::Bvh, seed: 0, filter: PixelFilter::Box }
     }
 }
 

@@ -41,6 +41,15 @@ fn every_strategy_converges_to_the_sphere_light_closed_form() {
             assert!((l - 0.125).abs() < 0.125 * tolerance, "{strategy} {integrator}: {l} (expected 0.125)");
         }
     }
+    // The balance heuristic weighs the same two samples differently, to the same mean.
+    let mut scene = sphere_light_scene(LightSampling::Mis, IntegratorKind::Direct);
+    scene.settings.mis_heuristic = raylab_render::integrator::MisHeuristic::Balance;
+    let l = mean(&render(&scene, &|_| {}).pixels);
+    assert!((l - 0.125).abs() < 0.125 * 0.01, "balance heuristic: {l} (expected 0.125)");
+    {
+        {
+        }
+    }
 }
 
 #[test]

@@ -8,6 +8,7 @@ use raylab_accel::AccelKind;
 use raylab_loader::Overrides;
 use raylab_render::filter::PixelFilter;
 use raylab_render::light::LightSampling;
+use raylab_render::integrator::MisHeuristic;
 use raylab_render::{IntegratorKind, SamplerKind, Scene};
 
 #[derive(Args, Clone, Debug, Default)]
@@ -49,6 +50,9 @@ pub struct SettingsArgs {
     /// Pixel filter: box, tent or gaussian
     #[arg(long)]
     pub filter: Option<String>,
+    /// MIS weights of light and BSDF samples: power (default) or balance
+    #[arg(long)]
+    pub mis_heuristic: Option<String>,
     /// Cells per side of the `cells` light-sampling grid (1 to 16; default 8)
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16))]
     pub light_cells: Option<u32>,
@@ -73,6 +77,7 @@ impl SettingsArgs {
             accel: self.accel.as_ref().map(parse_accel).transpose()?,
             seed: self.seed,
             light_cells: self.light_cells,
+            mis_heuristic: self.mis_heuristic.as_ref().map(|s| s.parse::<MisHeuristic>().map_err(|e| anyhow::anyhow!("--mis-heuristic: {e}"))).transpose()?,
             filter: self.filter.as_ref().map(|s| s.parse::<PixelFilter>().map_err(|e| anyhow::anyhow!("--filter: {e}"))).transpose()?,
             ..Overrides::default()
         })

@@ -2,10 +2,12 @@
 
 pub mod heatmap;
 pub(crate) mod kind;
+pub mod mis;
 mod path;
 mod whitted;
 
 pub use kind::IntegratorKind;
+pub use mis::MisHeuristic;
 
 use raylab_accel::Counters;
 use raylab_core::{Ray, Rgb};

@@ -6,7 +6,8 @@
 //! 2 adds direct lighting, and so on. Delta lights (point, directional) are always sampled;
 //! area lights by the scene's `light_sampling` strategy. A plain background is radiance from
 //! infinity found by BSDF sampling; an environment light is also sampled by luminance (every
-//! strategy but `bsdf`) and weighted against BSDF sampling under `mis`.
+//! strategy but `bsdf`) and weighted against BSDF sampling under `mis`
+//! (power heuristic by default, `[render] mis_heuristic`).
 
 use raylab_accel::Counters;
 use raylab_core::color::luminance;
@@ -17,20 +18,6 @@ use crate::light::LightSampling;
 use crate::sampler::PixelSampler;
 use crate::scene::SurfaceHit;
 use crate::Scene;
-
-/// Power heuristic with β = 2 (Veach 1997): the weight of a sample drawn with density
-/// `f` when `g` is the density of the other strategy.
-fn power_heuristic(f: f32, g: f32) -> f32 {
-    let (f2, g2) = (f * f, g * g);
-    if f2.is_infinite() {
-        return 1.0;
-    }
-    if f2 + g2 == 0.0 {
-        0.0
-    } else {
-        f2 / (f2 + g2)
-    }
-}
 
 /// The shading frame at a hit: for opaque BSDFs the shading normal turned towards `wo`
 /// (two-sided surfaces); for dielectrics oriented like the geometric normal, so that the
@@ -78,7 +65,7 @@ pub(super) fn radiance(scene: &Scene, camera_ray: &Ray, sampler: &mut PixelSampl
                 1.0
             } else if strategy == LightSampling::Mis {
                 let light_pdf = scene.area_lights.pdf(&scene.geometry, strategy, hit.prim, prev_p, hit.geom.p, hit.geom.ng);
-                power_heuristic(prev_pdf, light_pdf)
+                s.mis_heuristic.weight(prev_pdf, light_pdf)
             } else {
                 0.0 // counted by light sampling at the previous vertex
             };
@@ -131,7 +118,7 @@ fn environment_weight(scene: &Scene, specular: bool, prev_pdf: f32, dir: Vec3) -
     match &scene.environment {
         Some(env) if !specular && strategy.samples_lights() => {
             if strategy == LightSampling::Mis {
-                power_heuristic(prev_pdf, env.pdf(dir.normalize()))
+                scene.settings.mis_heuristic.weight(prev_pdf, env.pdf(dir.normalize()))
             } else {
                 0.0
             }
@@ -169,7 +156,7 @@ fn direct_light(scene: &Scene, hit: &SurfaceHit, bsdf: &Bsdf, frame: &Frame, wo:
             let wi_local = frame.to_local(es.wi);
             let f = bsdf.eval(wo_local, wi_local);
             if f != Rgb::ZERO && !scene.occluded(&hit.spawn_to(es.wi, f32::INFINITY), c) {
-                let weight = if strategy == LightSampling::Mis { power_heuristic(es.pdf, bsdf.pdf(wo_local, wi_local)) } else { 1.0 };
+                let weight = if strategy == LightSampling::Mis { scene.settings.mis_heuristic.weight(es.pdf, bsdf.pdf(wo_local, wi_local)) } else { 1.0 };
                 l += f * es.le * (wi_local.z.abs() * weight / es.pdf);
             }
         }
@@ -191,6 +178,6 @@ fn direct_light(scene: &Scene, hit: &SurfaceHit, bsdf: &Bsdf, frame: &Frame, wo:
     if f == Rgb::ZERO || scene.occluded(&hit.spawn_to(ls.wi, ls.dist), c) {
         return l;
     }
-    let weight = if strategy == LightSampling::Mis { power_heuristic(ls.pdf, bsdf.pdf(wo_local, wi_local)) } else { 1.0 };
+    let weight = if strategy == LightSampling::Mis { scene.settings.mis_heuristic.weight(ls.pdf, bsdf.pdf(wo_local, wi_local)) } else { 1.0 };
     l + f * ls.le * (wi_local.z.abs() * weight / ls.pdf)
 }
