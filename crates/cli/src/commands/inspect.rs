@@ -96,7 +96,7 @@ fn report(name: String, scene: &Scene) -> Report {
     let c = &scene.camera;
     let s = &scene.settings;
     let b = g.total_bounds();
-    let geometry_bytes = g.meshes.iter().map(|m| m.positions.len() * 12 + m.normals.len() * 12 + m.uvs.len() * 8 + m.indices.len() * 12).sum::<usize>()
+    let geometry_bytes = g.meshes.iter().map(|m| m.positions.len() * 12 + m.normals.len() * 12 + m.uvs.len() * 8 + m.tangents.len() * 16 + m.indices.len() * 12).sum::<usize>()
         + g.spheres.len() * std::mem::size_of::<raylab_render::Sphere>()
         + g.len() * 8;
     Report {
