@@ -96,3 +96,35 @@ fn rendering_with_a_self_baked_map_is_unchanged() {
     let tilted = render_normals(&low, Some(Texture::Constant(raylab_render::shading::encode_normal(Vec3::new(0.3, 0.0, 0.954)))));
     assert!(diff(&plain, &tilted) > 0.1, "a wrong map must show");
 }
+
+#[test]
+fn a_baked_tilt_decodes_to_the_high_normal_in_the_renderer() {
+    // Low: the unit square facing +z (two triangles). High: the plane z = 0.1·x, larger.
+    let square = |z: fn(f32) -> f32, lo: f32, hi: f32| {
+        let mut m = TriangleMesh {
+            positions: [(lo, lo), (hi, lo), (hi, hi), (lo, hi)].map(|(x, y)| Vec3::new(x, y, z(x))).to_vec(),
+            indices: vec![[0, 1, 2], [0, 2, 3]],
+            ..Default::default()
+        };
+        m.compute_smooth_normals();
+        m
+    };
+    let low = low_with_atlas(&square(|_| 0.0, 0.0, 1.0), 64);
+    let high = square(|x| 0.1 * x, -1.0, 2.0);
+    let map = bake_normal_map(&low, &high, 64, 0.3);
+    assert_eq!(map.hits, map.covered);
+    let camera = Camera::new(Vec3::new(0.5, 0.5, 3.0), Vec3::new(0.5, 0.5, 0.0), Vec3::Y, 40.0, 1.0, 0.0, None).unwrap();
+    let mut scene = Scene::new(camera, RenderSettings::default());
+    let t = scene.add_texture("map", Texture::Image(ImageTexture::new(64, 64, map.texels, Wrap::Clamp, Filter::Bilinear).unwrap()));
+    let m = scene.add_material("m", Material::default_diffuse());
+    scene.material_perturbations[m.0 as usize] = Some(ShadingPerturbation::NormalMap { texture: t, space: NormalSpace::Tangent });
+    scene.geometry.add_mesh(TriangleMesh { material: m, tangents: Vec::new(), ..low });
+    scene.build_accel(&BuildOptions::default());
+    let expected = Vec3::new(-0.1, 0.0, 1.0).normalize();
+    let mut rng = raylab_core::Pcg32::new(5, 6);
+    for _ in 0..500 {
+        let at = Vec3::new(rng.next_f32(), rng.next_f32(), 0.0);
+        let hit = scene.intersect(&Ray::new(at + Vec3::Z, -Vec3::Z), &mut raylab_accel::Counters::default()).unwrap();
+        assert!(hit.geom.ns.angle_between(expected) < 1e-3, "at {at}: {} instead of {expected}", hit.geom.ns);
+    }
+}
