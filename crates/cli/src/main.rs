@@ -31,6 +31,8 @@ enum Command {
     Converge(commands::converge::ConvergeArgs),
     /// Write a procedural test scene of any size (Haines' Standard Procedural Databases)
     Gen(commands::gen::GenArgs),
+    /// Bake a high-resolution mesh's normals into a normal map on a low-resolution one
+    Bake(commands::bake::BakeArgs),
 }
 
 fn main() -> ExitCode {
@@ -44,6 +46,7 @@ fn main() -> ExitCode {
         Some(Command::Trace(a)) => commands::trace::run(&a),
         Some(Command::Compare(a)) => commands::compare::run(&a),
         Some(Command::Converge(a)) => commands::converge::run(&a),
+        Some(Command::Bake(a)) => commands::bake::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -157,3 +157,22 @@ fn help_explains_every_render_option() {
         assert!(help.contains(option), "render --help lacks {option}");
     }
 }
+
+#[test]
+fn bake_writes_a_map_and_a_uv_mapped_mesh() {
+    let dir = scratch("bake");
+    let bunny = repo().join("assets/bunny_4968.obj");
+    let bunny = bunny.to_str().unwrap();
+    let o = raylab(&["bake", "--high", bunny, "--low", bunny, "-o", "normal.png", "--size", "1024"], &dir);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // Baked onto itself: flat everywhere, up to 8-bit rounding (≈ 0.004 per component).
+    let (w, h, texels) = read_image(&dir.join("normal.png"), false).unwrap();
+    assert_eq!((w, h), (1024, 1024));
+    let worst = texels.iter().map(|&c| raylab_render::shading::decode_normal(c).angle_between(raylab_core::Vec3::Z)).fold(0.0f32, f32::max);
+    assert!(worst < 0.02, "largest deviation {worst} rad");
+    let found = raylab_loader::files::Found::Disk(dir.join("bunny_4968_uv.obj"));
+    let obj = raylab_loader::obj::load_obj(&found, &raylab_core::Transform::IDENTITY).unwrap();
+    let (mesh, _) = &obj.meshes[0];
+    assert_eq!((mesh.len(), mesh.positions.len(), mesh.uvs.len(), mesh.normals.len()), (4968, 3 * 4968, 3 * 4968, 3 * 4968));
+    fails_with(&["bake", "--high", bunny, "--low", bunny, "-o", "n.png", "--size", "64"], &dir, "--size: a 64² texture is too small for 4968 triangles: cells of 1 texels");
+}

@@ -3,6 +3,7 @@
 
 pub mod bench;
 pub mod compare;
+pub mod bake;
 pub mod converge;
 pub mod rayfile;
 pub mod report;

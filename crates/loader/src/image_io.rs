@@ -271,6 +271,14 @@ pub fn write_image(path: &Path, width: u32, height: u32, pixels: &[Rgb], tonemap
     std::fs::write(path, bytes).map_err(|e| err(path, format!("cannot write: {e}")))
 }
 
+/// Writes 8-bit PNG values `round(255 · v)` with no tone map and no sRGB curve: for data
+/// such as normal maps, read back with `srgb = false`.
+pub fn write_linear_png(path: &Path, width: u32, height: u32, pixels: &[Rgb]) -> Result<(), ImageError> {
+    assert_eq!(pixels.len(), width as usize * height as usize, "pixel count must match the size");
+    let bytes: Vec<u8> = pixels.iter().flat_map(|p| [p.x, p.y, p.z]).map(|v| (finite_or_zero(v).clamp(0.0, 1.0) * 255.0).round() as u8).collect();
+    image::save_buffer(path, &bytes, width, height, image::ExtendedColorType::Rgb8).map_err(|e| err(path, format!("cannot write PNG: {e}")))
+}
+
 fn finite_or_zero(v: f32) -> f32 {
     if v.is_finite() { v } else { 0.0 }
 }
@@ -287,6 +295,19 @@ fn write_exr(path: &Path, width: u32, height: u32, pixels: &[Rgb], exposure: f32
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn linear_png_round_trips_without_srgb() {
+        let path = std::env::temp_dir().join(format!("raylab-linear-{}.png", std::process::id()));
+        let pixels = vec![Rgb::new(0.5, 0.25, 1.0), Rgb::new(0.0, 0.8, 0.1)];
+        write_linear_png(&path, 2, 1, &pixels).unwrap();
+        let (w, h, back) = read_image(&path, false).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        assert_eq!((w, h), (2, 1));
+        for (a, b) in back.iter().zip(&pixels) {
+            assert!((*a - *b).abs().max_element() <= 0.5 / 255.0 + 1e-6, "{a} vs {b}");
+        }
+    }
 
     fn gradient(w: u32, h: u32) -> Vec<Rgb> {
         (0..w * h).map(|i| Rgb::new((i % w) as f32 / w as f32, (i / w) as f32 / h as f32, 0.25 + i as f32 * 0.01)).collect()

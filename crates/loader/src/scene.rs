@@ -1,6 +1,6 @@
 //! Scene files (TOML) to [`Scene`]s. The format is documented in `docs/scene-format.md`.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
 use raylab_accel::{AccelKind, BuildOptions};
@@ -10,6 +10,7 @@ use raylab_render::filter::PixelFilter;
 use raylab_render::integrator::MisHeuristic;
 use raylab_render::light::{EnvironmentLight, LightSampling, MAX_CELLS};
 use raylab_render::material::{TexColor, METALS};
+use raylab_render::shading::{NormalSpace, ShadingPerturbation};
 use raylab_render::shape::Sphere;
 use raylab_render::texture::{Checker, CheckerSpace, Filter, ImageTexture, Noise, NoiseKind, Wrap};
 use raylab_render::{Background, Camera, IntegratorKind, Light, Material, MaterialId, RenderSettings, SamplerKind, Scene, Texture, TriangleMesh};
@@ -60,8 +61,11 @@ const RENDER: &[&str] = &["spp", "sampler", "max_depth", "integrator", "light_sa
 const BACKGROUND: &[&str] = &["color", "texture"];
 const TEXTURE: &[&str] = &["name", "type", "file", "wrap", "filter", "srgb", "scale", "even", "odd", "space", "kind", "colors", "octaves", "seed", "color"];
 const MATERIAL: &[&str] = &[
-    "name", "type", "albedo", "ka", "kd", "ks", "exponent", "reflectance", "ior", "diffuse", "specular", "roughness", "distribution", "geometry", "f0", "metal", "eta", "k",
+    "name", "type", "albedo", "ka", "kd", "ks", "exponent", "reflectance", "ior", "diffuse", "specular", "roughness", "distribution", "geometry", "f0", "metal", "eta", "k", "normal_map",
+    "normal_space", "bump_map", "bump_scale",
 ];
+/// Fields every material kind has.
+const MATERIAL_COMMON: &[&str] = &["name", "type", "normal_map", "normal_space", "bump_map", "bump_scale"];
 const SHAPE: &[&str] = &["type", "material", "transform", "center", "radius", "vertices", "normals", "uvs", "file", "smooth"];
 const LIGHT: &[&str] = &["type", "position", "intensity", "direction", "irradiance", "vertices", "radiance", "texture", "center", "radius", "n", "file", "scale"];
 const TRANSFORM_STEP: &[&str] = &["scale", "rotate", "translate"];
@@ -79,7 +83,15 @@ pub fn load_scene_str(src: &str, path: &Path, resolver: &Resolver, overrides: &O
     let doc = Doc::new(path, src);
     let root = doc.parse(src)?;
     let top = Table::new(&doc, String::new(), root.span(), root.get_ref(), TOP)?;
-    let mut b = Builder { doc: &doc, resolver, texture_ids: HashMap::new(), material_ids: HashMap::new(), mtl_cache: HashMap::new(), has_background: top.has("background") };
+    let mut b = Builder {
+        doc: &doc,
+        resolver,
+        texture_ids: HashMap::new(),
+        srgb_textures: HashSet::new(),
+        material_ids: HashMap::new(),
+        mtl_cache: HashMap::new(),
+        has_background: top.has("background"),
+    };
 
     let settings = b.settings(&top, overrides)?;
     let camera = b.camera(&top, &settings)?;
@@ -107,6 +119,8 @@ struct Builder<'a> {
     doc: &'a Doc<'a>,
     resolver: &'a Resolver,
     texture_ids: HashMap<String, raylab_render::TextureId>,
+    /// Image textures decoded from sRGB, which cannot hold normal maps.
+    srgb_textures: HashSet<raylab_render::TextureId>,
     material_ids: HashMap<String, MaterialId>,
     /// MTL materials already converted, by (MTL path, index).
     mtl_cache: HashMap<(String, usize), MaterialId>,
@@ -244,6 +258,7 @@ impl Builder<'_> {
             }
             Ok(())
         };
+        let mut srgb = false;
         let tex = match kind {
             "image" => {
                 only(&["file", "wrap", "filter", "srgb"])?;
@@ -251,7 +266,7 @@ impl Builder<'_> {
                 let found = self.find(&file)?;
                 let wrap = t.opt("wrap", |v| v.str()?.parse::<Wrap>().map_err(|e| v.err(e.to_string())))?.unwrap_or(Wrap::Repeat);
                 let filter = t.opt("filter", |v| v.str()?.parse::<Filter>().map_err(|e| v.err(e.to_string())))?.unwrap_or(Filter::Bilinear);
-                let srgb = t.opt("srgb", |v| v.bool())?.unwrap_or(true);
+                srgb = t.opt("srgb", |v| v.bool())?.unwrap_or(true);
                 Texture::Image(self.image_texture(&file, &found, srgb, wrap, filter)?)
             }
             "checker" => {
@@ -287,6 +302,9 @@ impl Builder<'_> {
             }
         };
         let id = scene.add_texture(name.clone(), tex);
+        if srgb {
+            self.srgb_textures.insert(id);
+        }
         self.texture_ids.insert(name, id);
         Ok(())
     }
@@ -319,8 +337,8 @@ impl Builder<'_> {
             _ => &["ior"],
         };
         for k in MATERIAL {
-            if !["name", "type"].contains(k) && !valid.contains(k) && t.has(k) {
-                return Err(t.get(k).unwrap().err(format!("not a field of `{kind}` materials (valid: name, type, {})", valid.join(", "))));
+            if !MATERIAL_COMMON.contains(k) && !valid.contains(k) && t.has(k) {
+                return Err(t.get(k).unwrap().err(format!("not a field of `{kind}` materials (valid: {}, {})", MATERIAL_COMMON.join(", "), valid.join(", "))));
             }
         }
         let color = |key: &str, default: Rgb| -> Result<TexColor, LoadError> { t.get(key).map(|v| self.tex_color(&v)).transpose().map(|c| c.unwrap_or(TexColor::Constant(default))) };
@@ -358,7 +376,9 @@ impl Builder<'_> {
             }
             _ => Material::Dielectric { ior: t.opt("ior", |v| positive(v, v.f32()?))?.unwrap_or(1.5) },
         };
+        let perturbation = self.perturbation(t)?;
         let id = scene.add_material(name.clone(), m);
+        scene.material_perturbations[id.0 as usize] = perturbation;
         self.material_ids.insert(name, id);
         Ok(())
     }
@@ -382,6 +402,42 @@ impl Builder<'_> {
                 })?;
                 Ok((Rgb::from_array(*eta), Rgb::from_array(*k)))
             }
+        }
+    }
+
+    /// A material's `normal_map` (with `normal_space`) or `bump_map` (with `bump_scale`).
+    fn perturbation(&self, t: &Table) -> Result<Option<ShadingPerturbation>, LoadError> {
+        let texture = |v: &Val| match self.tex_color(v)? {
+            TexColor::Texture(id) => Ok(id),
+            TexColor::Constant(_) => Err(v.err("expected the name of a texture")),
+        };
+        let needs = |key: &str, other: &str| match t.get(key) {
+            Some(v) if !t.has(other) => Err(v.err(format!("needs `{other}`"))),
+            _ => Ok(()),
+        };
+        needs("normal_space", "normal_map")?;
+        needs("bump_scale", "bump_map")?;
+        match (t.get("normal_map"), t.get("bump_map")) {
+            (Some(_), Some(b)) => Err(b.err("give either `normal_map` or `bump_map`, not both")),
+            (Some(v), None) => {
+                let id = texture(&v)?;
+                if self.srgb_textures.contains(&id) {
+                    return Err(v.err(format!("texture `{}` is decoded from sRGB, but a normal map holds linear vectors: give it `srgb = false`", v.str()?)));
+                }
+                let space = t.opt("normal_space", |v| v.str()?.parse::<NormalSpace>().map_err(|e| v.err(e)))?.unwrap_or_default();
+                Ok(Some(ShadingPerturbation::NormalMap { texture: id, space }))
+            }
+            (None, Some(v)) => {
+                let texture = texture(&v)?;
+                // Required: the height is in world units, so no default fits every scene.
+                let sv = t.req("bump_scale")?;
+                let scale = sv.f32()?;
+                if scale == 0.0 {
+                    return Err(sv.err("must not be zero"));
+                }
+                Ok(Some(ShadingPerturbation::Bump { texture, scale }))
+            }
+            (None, None) => Ok(None),
         }
     }
 
@@ -471,7 +527,7 @@ impl Builder<'_> {
                 if verts.len() != n {
                     return Err(vv.err(format!("expected {n} vertices, found {}", verts.len())));
                 }
-                let mut mesh = TriangleMesh { name: kind.into(), positions: verts.iter().map(|&p| to_world.point(p)).collect(), material: mat, ..Default::default() };
+                let mut mesh = TriangleMesh { name: kind.into(), positions: verts.iter().map(|&p| to_world.point(p)).collect(), material: mat, object_to_world: to_world, ..Default::default() };
                 mesh.indices = if n == 3 { vec![[0, 1, 2]] } else { vec![[0, 1, 2], [0, 2, 3]] };
                 if let Some(nv) = t.get("normals") {
                     let normals = nv.points()?;
@@ -510,6 +566,7 @@ impl Builder<'_> {
                     if smooth && mesh.normals.is_empty() {
                         mesh.compute_smooth_normals();
                     }
+                    mesh.object_to_world = to_world;
                     scene.geometry.add_mesh(mesh);
                 }
             }

@@ -143,3 +143,38 @@ fn conductor_errors() {
 fn mis_heuristic_names_the_valid_ones() {
     assert_eq!(error_of(&format!("{CAMERA}[render]\nmis_heuristic = \"cutoff\"\n")), "bad.toml:6: render.mis_heuristic: unknown MIS heuristic `cutoff` (valid: power, balance)");
 }
+
+#[test]
+fn normal_and_bump_map_errors() {
+    // Lines 5-8: a constant texture `h`; 9-11: a diffuse material; its extra fields from 12.
+    let material = |extra: &str| error_of(&format!("{CAMERA}[[textures]]\nname = \"h\"\ntype = \"constant\"\ncolor = 0.5\n[[materials]]\nname = \"m\"\ntype = \"diffuse\"\n{extra}"));
+    assert_eq!(material("normal_map = \"h\"\nbump_map = \"h\"\nbump_scale = 0.1\n"), "bad.toml:13: materials[0].bump_map: give either `normal_map` or `bump_map`, not both");
+    assert_eq!(material("normal_space = \"tangent\"\n"), "bad.toml:12: materials[0].normal_space: needs `normal_map`");
+    assert_eq!(material("bump_scale = 0.1\n"), "bad.toml:12: materials[0].bump_scale: needs `bump_map`");
+    assert_eq!(material("normal_map = \"h\"\nnormal_space = \"world\"\n"), "bad.toml:13: materials[0].normal_space: unknown normal space `world` (valid: tangent, object)");
+    assert_eq!(material("normal_map = \"nm\"\n"), "bad.toml:12: materials[0].normal_map: unknown texture `nm` (defined: h)");
+    assert_eq!(material("normal_map = [0.5, 0.5, 1]\n"), "bad.toml:12: materials[0].normal_map: expected the name of a texture");
+    assert_eq!(material("bump_map = \"h\"\n"), "bad.toml:9: materials[0].bump_scale: missing (required)");
+    assert_eq!(material("bump_map = \"h\"\nbump_scale = 0\n"), "bad.toml:13: materials[0].bump_scale: must not be zero");
+    assert_eq!(material("albedo = 1\nior = 1.5\n"), "bad.toml:13: materials[0].ior: not a field of `diffuse` materials (valid: name, type, normal_map, normal_space, bump_map, bump_scale, albedo)");
+    // An image decoded from sRGB would bend every normal: it must be read as linear.
+    let srgb = error_of(&format!(
+        "{CAMERA}[[textures]]\nname = \"nm\"\ntype = \"image\"\nfile = \"textures/grass_normal_1024.jpg\"\n[[materials]]\nname = \"m\"\ntype = \"diffuse\"\nnormal_map = \"nm\"\n"
+    ));
+    assert_eq!(srgb, "bad.toml:12: materials[0].normal_map: texture `nm` is decoded from sRGB, but a normal map holds linear vectors: give it `srgb = false`");
+}
+
+#[test]
+fn normal_and_bump_maps_load() {
+    let src = format!(
+        "{CAMERA}[[textures]]\nname = \"nm\"\ntype = \"image\"\nfile = \"textures/grass_normal_1024.jpg\"\nsrgb = false\n\
+         [[textures]]\nname = \"h\"\ntype = \"checker\"\n\
+         [[materials]]\nname = \"mapped\"\ntype = \"phong\"\nnormal_map = \"nm\"\nnormal_space = \"object\"\n\
+         [[materials]]\nname = \"bumpy\"\ntype = \"mirror\"\nbump_map = \"h\"\nbump_scale = -0.5\n\
+         [[shapes]]\ntype = \"quad\"\nvertices = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]\nmaterial = \"mapped\"\n"
+    );
+    let scene = load_scene_str(&src, Path::new("ok.toml"), &Resolver::Disk { base: fixtures() }, &Overrides::default()).unwrap();
+    use raylab_render::shading::{NormalSpace, ShadingPerturbation};
+    use raylab_render::TextureId;
+    assert_eq!(scene.material_perturbations, vec![None, Some(ShadingPerturbation::NormalMap { texture: TextureId(0), space: NormalSpace::Object }), Some(ShadingPerturbation::Bump { texture: TextureId(1), scale: -0.5 })]);
+}

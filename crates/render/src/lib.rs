@@ -11,6 +11,7 @@ pub mod material;
 pub mod render;
 pub mod sampler;
 pub mod scene;
+pub mod shading;
 pub mod shape;
 pub mod texture;
 

@@ -8,6 +8,7 @@ use crate::integrator::MisHeuristic;
 use crate::light::{AreaLights, EnvironmentLight, Light, LightSampling};
 use crate::material::{Material, MaterialId, TextureId};
 use crate::sampler::SamplerKind;
+use crate::shading::ShadingPerturbation;
 use crate::shape::{Geometry, SurfaceGeometry};
 use crate::texture::{equirect_uv, Texture};
 
@@ -80,6 +81,9 @@ pub struct Scene {
     pub geometry: Geometry,
     pub materials: Vec<Material>,
     pub material_names: Vec<String>,
+    /// Each material's normal or bump map, if any, parallel to `materials` (kept out of the
+    /// `Material` enum so that every material kind can have one).
+    pub material_perturbations: Vec<Option<ShadingPerturbation>>,
     pub textures: Vec<Texture>,
     pub texture_names: Vec<String>,
     pub lights: Vec<Light>,
@@ -102,6 +106,7 @@ impl Scene {
             geometry,
             materials: vec![Material::default_diffuse()],
             material_names: vec!["default".into()],
+            material_perturbations: vec![None],
             textures: Vec::new(),
             texture_names: Vec::new(),
             lights: Vec::new(),
@@ -112,9 +117,15 @@ impl Scene {
         }
     }
 
-    /// (Re)builds the acceleration structure named in the settings; call after the geometry
-    /// changes.
+    /// (Re)builds the acceleration structure named in the settings, and the tangents of
+    /// meshes whose material has a tangent-space normal map; call after the geometry changes.
     pub fn build_accel(&mut self, opts: &BuildOptions) {
+        for mesh in &mut self.geometry.meshes {
+            let needs = self.material_perturbations[mesh.material.0 as usize].is_some_and(|p| p.needs_tangents());
+            if needs && mesh.tangents.is_empty() && !mesh.uvs.is_empty() {
+                mesh.compute_tangents();
+            }
+        }
         self.accel = AnyAccel::build(self.settings.accel, &self.geometry, opts);
         self.area_lights = AreaLights::new(&self.geometry, self.settings.light_cells);
     }
@@ -127,7 +138,12 @@ impl Scene {
     pub fn intersect(&self, ray: &Ray, counters: &mut Counters) -> Option<SurfaceHit> {
         debug_assert_eq!(self.accel.stats().primitives, self.geometry.len(), "build_accel() after adding geometry");
         let h = self.accel.intersect(&self.geometry, ray, counters)?;
-        Some(SurfaceHit { t: h.t, prim: h.prim, geom: self.geometry.surface(ray, h.prim, h.t, h.u, h.v), material: self.geometry.material(h.prim) })
+        let material = self.geometry.material(h.prim);
+        let mut geom = self.geometry.surface(ray, h.prim, h.t, h.u, h.v);
+        if let Some(p) = &self.material_perturbations[material.0 as usize] {
+            geom.ns = p.shading_normal(&self.textures, &self.geometry, h.prim, h.u, h.v, &geom);
+        }
+        Some(SurfaceHit { t: h.t, prim: h.prim, geom, material })
     }
 
     pub fn occluded(&self, ray: &Ray, counters: &mut Counters) -> bool {
@@ -157,6 +173,7 @@ impl Scene {
     pub fn add_material(&mut self, name: impl Into<String>, m: Material) -> MaterialId {
         self.materials.push(m);
         self.material_names.push(name.into());
+        self.material_perturbations.push(None);
         MaterialId(self.materials.len() as u32 - 1)
     }
 

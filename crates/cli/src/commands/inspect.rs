@@ -32,6 +32,8 @@ struct Report {
     background: String,
     bounds: [[f32; 3]; 2],
     geometry_bytes: usize,
+    /// Texels of image textures (normal maps included), 12 bytes each.
+    texture_bytes: usize,
     accel: AccelStats,
 }
 
@@ -96,9 +98,13 @@ fn report(name: String, scene: &Scene) -> Report {
     let c = &scene.camera;
     let s = &scene.settings;
     let b = g.total_bounds();
-    let geometry_bytes = g.meshes.iter().map(|m| m.positions.len() * 12 + m.normals.len() * 12 + m.uvs.len() * 8 + m.indices.len() * 12).sum::<usize>()
+    let geometry_bytes = g.meshes.iter().map(|m| m.positions.len() * 12 + m.normals.len() * 12 + m.uvs.len() * 8 + m.tangents.len() * 16 + m.indices.len() * 12).sum::<usize>()
         + g.spheres.len() * std::mem::size_of::<raylab_render::Sphere>()
         + g.len() * 8;
+    let texture_bytes = scene.textures.iter().map(|t| match t {
+        raylab_render::Texture::Image(i) => i.width() as usize * i.height() as usize * std::mem::size_of::<raylab_core::Rgb>(),
+        _ => 0,
+    }).sum();
     Report {
         scene: name,
         camera: CameraInfo { from: v3(c.from), at: v3(c.at), up: v3(c.up), vfov: c.vfov, aperture: c.aperture, focus_distance: c.focus_distance },
@@ -149,6 +155,7 @@ fn report(name: String, scene: &Scene) -> Report {
         },
         bounds: if b.is_empty() { [[0.0; 3]; 2] } else { [v3(b.min), v3(b.max)] },
         geometry_bytes,
+        texture_bytes,
         accel: scene.accel().stats(),
     }
 }
@@ -182,7 +189,7 @@ pub fn run(a: &InspectArgs) -> Result<()> {
         n.shapes, n.meshes, n.triangles, n.spheres, n.materials, n.textures, n.lights, n.area_light_primitives
     );
     println!("bounds      {:?} .. {:?}", r.bounds[0], r.bounds[1]);
-    println!("memory      geometry {:.1} KiB, acceleration structure {:.1} KiB", r.geometry_bytes as f64 / 1024.0, r.accel.memory_bytes as f64 / 1024.0);
+    println!("memory      geometry {:.1} KiB, textures {:.1} KiB, acceleration structure {:.1} KiB", r.geometry_bytes as f64 / 1024.0, r.texture_bytes as f64 / 1024.0, r.accel.memory_bytes as f64 / 1024.0);
     println!("background  {}", r.background);
     if !r.meshes.is_empty() {
         println!("meshes:");

@@ -1,4 +1,5 @@
-use raylab_core::{intersect, Aabb, Ray, Rgb, Vec2, Vec3};
+use glam::Vec4;
+use raylab_core::{intersect, Aabb, Frame, Ray, Rgb, Transform, Vec2, Vec3};
 
 use super::SurfaceGeometry;
 use crate::material::{MaterialId, TextureId};
@@ -13,6 +14,12 @@ pub struct TriangleMesh {
     pub normals: Vec<Vec3>,
     /// Empty, or one coordinate per position.
     pub uvs: Vec<Vec2>,
+    /// Empty, or one per position for tangent-space normal maps: `xyz` the unit tangent along
+    /// +u, `w = ±1` the bitangent sign, `b = w · (n × t)` (MikkTSpace's convention).
+    pub tangents: Vec<Vec4>,
+    /// The transform the mesh was loaded with (its positions are already in world space), for
+    /// object-space normal maps.
+    pub object_to_world: Transform,
     pub indices: Vec<[u32; 3]>,
     pub material: MaterialId,
     /// Radiance emitted on the side of the winding normal `(p1 - p0) × (p2 - p0)`, zero for
@@ -75,14 +82,11 @@ impl TriangleMesh {
         let e1 = p1 - p0;
         let e2 = p2 - p0;
         let mut ng = e1.cross(e2).try_normalize().unwrap_or(Vec3::Y);
-        let (uv, dpdu) = if self.uvs.is_empty() {
-            (Vec2::new(b1, b2), e1)
+        let (uv, (dpdu, dpdv)) = if self.uvs.is_empty() {
+            (Vec2::new(b1, b2), (e1, e2))
         } else {
             let [t0, t1, t2] = idx.map(|i| self.uvs[i]);
-            let (d1, d2) = (t1 - t0, t2 - t0);
-            let det = d1.x * d2.y - d1.y * d2.x;
-            let dpdu = if det.abs() > 1e-12 { (d2.y * e1 - d1.y * e2) / det } else { e1 };
-            (b0 * t0 + b1 * t1 + b2 * t2, dpdu)
+            (b0 * t0 + b1 * t1 + b2 * t2, uv_derivatives(e1, e2, t1 - t0, t2 - t0).unwrap_or((e1, e2)))
         };
         let ns = if self.normals.is_empty() {
             ng
@@ -96,7 +100,7 @@ impl TriangleMesh {
             }
             n
         };
-        SurfaceGeometry { p, p_error, ng, ns, uv, dpdu }
+        SurfaceGeometry { p, p_error, ng, ns, uv, dpdu, dpdv }
     }
 
     /// Angle-weighted vertex normals (Thürmer & Wüthrich 1998) for `smooth = true` on meshes
@@ -122,6 +126,61 @@ impl TriangleMesh {
         self.normals = groups.iter().map(|&g| n[g].try_normalize().unwrap_or(Vec3::Y)).collect();
     }
 
+    /// Per-vertex tangents for tangent-space normal maps (needs `uvs`). Each triangle's unit
+    /// ∂p/∂u and ∂p/∂v are summed at its corners weighted by the corner angle, as MikkTSpace
+    /// does; the tangent is then made orthogonal to the vertex normal (Gram–Schmidt) and
+    /// `w` records whether ∂p/∂v lies along `n × t` (+1) or against it (-1, mirrored UVs).
+    /// Unlike MikkTSpace, a vertex shared by faces of opposite UV orientation is not split:
+    /// the angle-weighted majority decides its sign.
+    pub fn compute_tangents(&mut self) {
+        assert_eq!(self.uvs.len(), self.positions.len(), "tangents need one UV per vertex");
+        let n = self.positions.len();
+        let (mut su, mut sv, mut sn) = (vec![Vec3::ZERO; n], vec![Vec3::ZERO; n], vec![Vec3::ZERO; n]);
+        for &tri in &self.indices {
+            let p = tri.map(|i| self.positions[i as usize]);
+            let t = tri.map(|i| self.uvs[i as usize]);
+            let Some((dpdu, dpdv)) = uv_derivatives(p[1] - p[0], p[2] - p[0], t[1] - t[0], t[2] - t[0]) else { continue };
+            let (Some(tu), Some(tv), Some(face)) = (dpdu.try_normalize(), dpdv.try_normalize(), (p[1] - p[0]).cross(p[2] - p[0]).try_normalize()) else { continue };
+            for k in 0..3 {
+                let angle = (p[(k + 1) % 3] - p[k]).angle_between(p[(k + 2) % 3] - p[k]);
+                if angle.is_finite() {
+                    let i = tri[k] as usize;
+                    su[i] += angle * tu;
+                    sv[i] += angle * tv;
+                    sn[i] += angle * face;
+                }
+            }
+        }
+        self.tangents = (0..n)
+            .map(|i| {
+                let normal = self.normals.get(i).copied().or_else(|| sn[i].try_normalize()).unwrap_or(Vec3::Z);
+                let t = (su[i] - normal * normal.dot(su[i])).try_normalize().unwrap_or_else(|| Frame::from_z(normal).x);
+                let w = if normal.cross(t).dot(sv[i]) < 0.0 { -1.0 } else { 1.0 };
+                t.extend(w)
+            })
+            .collect();
+    }
+
+    /// The tangent and bitangent sign at barycentrics `(b1, b2)`, interpolated from the
+    /// per-vertex tangents; `None` when the mesh has none.
+    pub fn interpolated_tangent(&self, tri: u32, b1: f32, b2: f32) -> Option<(Vec3, f32)> {
+        if self.tangents.is_empty() {
+            return None;
+        }
+        let [t0, t1, t2] = self.indices[tri as usize].map(|i| self.tangents[i as usize]);
+        let t = (1.0 - b1 - b2) * t0 + b1 * t1 + b2 * t2;
+        Some((t.truncate(), if t.w < 0.0 { -1.0 } else { 1.0 }))
+    }
+}
+
+/// ∂p/∂u and ∂p/∂v of a triangle with edges `e1 = p1 - p0`, `e2 = p2 - p0` and UV edges
+/// `d1`, `d2` (pbrt-v4 §6.5.3); `None` when the UVs are degenerate.
+fn uv_derivatives(e1: Vec3, e2: Vec3, d1: Vec2, d2: Vec2) -> Option<(Vec3, Vec3)> {
+    let det = d1.x * d2.y - d1.y * d2.x;
+    if det.abs() <= 1e-12 {
+        return None;
+    }
+    Some(((d2.y * e1 - d1.y * e2) / det, (d1.x * e2 - d2.x * e1) / det))
 }
 
 #[cfg(test)]

@@ -28,6 +28,8 @@ pub struct SurfaceGeometry {
     pub uv: Vec2,
     /// ∂p/∂u, for tangent frames; not normalised.
     pub dpdu: Vec3,
+    /// ∂p/∂v, for bump maps and the bitangent's sign; not normalised.
+    pub dpdv: Vec3,
 }
 
 /// Which shape a primitive belongs to.
@@ -85,6 +87,27 @@ impl Geometry {
             PrimRef::Triangle { mesh, tri } => self.meshes[mesh as usize].surface(tri, u, v),
             PrimRef::Sphere(s) => self.spheres[s as usize].surface(ray, t),
         }
+    }
+
+    /// The tangent (along +u) and bitangent sign that tangent-space normal maps are decoded
+    /// with at hit `(b1, b2)` of `prim` (see [`crate::shading::TangentFrame`]): a mesh's
+    /// interpolated per-vertex tangents, else ∂p/∂u with the side of ∂p/∂v.
+    pub fn tangent(&self, prim: u32, b1: f32, b2: f32, geom: &SurfaceGeometry) -> (Vec3, f32) {
+        if let PrimRef::Triangle { mesh, tri } = self.prims[prim as usize] {
+            if let Some(t) = self.meshes[mesh as usize].interpolated_tangent(tri, b1, b2) {
+                return t;
+            }
+        }
+        (geom.dpdu, if geom.ns.cross(geom.dpdu).dot(geom.dpdv) < 0.0 { -1.0 } else { 1.0 })
+    }
+
+    /// A normal in the object space of `prim`'s shape, in world space (unit).
+    pub fn object_normal_to_world(&self, prim: u32, n: Vec3) -> Vec3 {
+        let to_world = match self.prims[prim as usize] {
+            PrimRef::Triangle { mesh, .. } => &self.meshes[mesh as usize].object_to_world,
+            PrimRef::Sphere(s) => &self.spheres[s as usize].to_world,
+        };
+        to_world.normal(n).try_normalize().unwrap_or(n)
     }
 
     /// Radiance the primitive emits (zero for most).

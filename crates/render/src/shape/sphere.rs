@@ -46,8 +46,15 @@ impl Sphere {
         let theta = (-local.y).clamp(-1.0, 1.0).acos();
         let phi = (-local.z).atan2(local.x) + PI;
         let uv = Vec2::new(phi / (2.0 * PI), theta / PI);
-        // ∂p/∂u points along increasing longitude; used for tangent frames (normal maps).
-        let dpdu_obj = Vec3::new(local.z, 0.0, -local.x) * (-2.0 * PI * self.radius);
+        // ∂p/∂u (along increasing longitude) and ∂p/∂v (towards the north pole), for tangent
+        // frames and bump maps. With α = atan2(-z, x): x = ρ cos α, z = -ρ sin α, ρ = sin θ.
+        let dpdu_obj = Vec3::new(local.z, 0.0, -local.x) * (2.0 * PI * self.radius);
+        let rho = (local.x * local.x + local.z * local.z).sqrt();
+        let dpdv_obj = if rho > 1e-6 {
+            Vec3::new(-local.y * local.x / rho, rho, -local.y * local.z / rho) * (PI * self.radius)
+        } else {
+            Vec3::X * (PI * self.radius) // at a pole any horizontal direction will do
+        };
         let n = self.to_world.normal(local).normalize();
         // Reprojection leaves a relative error of γ₅ per coordinate (pbrt-v4 §6.8.5); the
         // transform adds its own rounding (§6.8.4).
@@ -59,6 +66,33 @@ impl Sphere {
             let abs_m = glam::Mat3::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
             abs_m * err_obj + raylab_core::gamma(3) * (abs_m * p_obj.abs() + Vec3::from(self.to_world.m.translation).abs())
         };
-        SurfaceGeometry { p: self.to_world.point(p_obj), p_error, ng: n, ns: n, uv, dpdu: self.to_world.vector(dpdu_obj) }
+        SurfaceGeometry { p: self.to_world.point(p_obj), p_error, ng: n, ns: n, uv, dpdu: self.to_world.vector(dpdu_obj), dpdv: self.to_world.vector(dpdv_obj) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// ∂p/∂u and ∂p/∂v agree with finite differences of the point at `uv ± h`.
+    #[test]
+    fn partial_derivatives_match_finite_differences() {
+        let s = Sphere { center: Vec3::new(1.0, 2.0, 3.0), radius: 2.0, to_world: Transform::IDENTITY, material: MaterialId(0), emission: Rgb::ZERO };
+        let point = |u: f32, v: f32| {
+            let (theta, alpha) = (v * PI, u * 2.0 * PI - PI);
+            s.center + s.radius * Vec3::new(theta.sin() * alpha.cos(), -theta.cos(), -theta.sin() * alpha.sin())
+        };
+        for (u, v) in [(0.1, 0.3), (0.6, 0.5), (0.9, 0.8)] {
+            let p = point(u, v);
+            let ray = Ray::new(s.center + 2.0 * (p - s.center), s.center - p);
+            let t = s.intersect(&ray).unwrap();
+            let g = s.surface(&ray, t);
+            assert!((g.uv - Vec2::new(u, v)).length() < 1e-4, "{}", g.uv);
+            let h = 1e-3;
+            let fd_u = (point(u + h, v) - point(u - h, v)) / (2.0 * h);
+            let fd_v = (point(u, v + h) - point(u, v - h)) / (2.0 * h);
+            assert!((g.dpdu - fd_u).length() < 1e-2 * fd_u.length(), "{} vs {fd_u}", g.dpdu);
+            assert!((g.dpdv - fd_v).length() < 1e-2 * fd_v.length(), "{} vs {fd_v}", g.dpdv);
+        }
     }
 }

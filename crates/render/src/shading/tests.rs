@@ -1,0 +1,157 @@
+//! Perturbed normals against hand-computed ones, through `Scene::intersect` as the
+//! integrators see them.
+
+use raylab_accel::{BuildOptions, Counters};
+use raylab_core::{Pcg32, Ray, Rgb, Transform, Vec2, Vec3};
+
+use super::*;
+use crate::texture::{Filter, ImageTexture, Wrap};
+use crate::{Camera, Material, RenderSettings, Scene, Sphere, TriangleMesh};
+
+fn scene() -> Scene {
+    let camera = Camera::new(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 40.0, 1.0, 0.0, None).unwrap();
+    Scene::new(camera, RenderSettings::default())
+}
+
+/// The unit square in the xy plane facing +z, with the given corner UVs.
+fn square(uvs: [Vec2; 4]) -> TriangleMesh {
+    TriangleMesh {
+        positions: vec![Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
+        uvs: uvs.to_vec(),
+        indices: vec![[0, 1, 2], [0, 2, 3]],
+        ..Default::default()
+    }
+}
+
+const UP: [Vec2; 4] = [Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0)];
+/// The same square with `v` running down (-y).
+const V_FLIPPED: [Vec2; 4] = [Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 0.0)];
+
+/// A scene with `mesh` under a material perturbed by `p(texture)` for a texture `tex`.
+fn with_map(mut mesh: TriangleMesh, tex: Texture, p: impl Fn(TextureId) -> ShadingPerturbation) -> Scene {
+    let mut s = scene();
+    let t = s.add_texture("map", tex);
+    let m = s.add_material("m", Material::default_diffuse());
+    s.material_perturbations[m.0 as usize] = Some(p(t));
+    mesh.material = m;
+    s.geometry.add_mesh(mesh);
+    s.build_accel(&BuildOptions::default());
+    s
+}
+
+fn tangent_map(t: TextureId) -> ShadingPerturbation {
+    ShadingPerturbation::NormalMap { texture: t, space: NormalSpace::Tangent }
+}
+
+/// Shading normal seen by a ray from `from` towards `at`.
+fn ns_at(s: &Scene, from: Vec3, at: Vec3) -> Vec3 {
+    s.intersect(&Ray::new(from, at - from), &mut Counters::default()).expect("hit").geom.ns
+}
+
+fn assert_close(a: Vec3, b: Vec3, tol: f32) {
+    assert!((a - b).length() < tol, "{a} vs {b}");
+}
+
+fn constant(n: Vec3) -> Texture {
+    Texture::Constant(encode_normal(n))
+}
+
+#[test]
+fn tangent_space_normal_map_gives_the_hand_computed_normal() {
+    let from = Vec3::new(0.3, 0.4, 2.0);
+    let at = Vec3::new(0.3, 0.4, 0.0);
+    // u along +x, v along +y: t = x, b = +(z × x) = y.
+    let s = with_map(square(UP), constant(Vec3::new(0.6, 0.0, 0.8)), tangent_map);
+    assert_close(ns_at(&s, from, at), Vec3::new(0.6, 0.0, 0.8), 1e-5);
+    let s = with_map(square(UP), constant(Vec3::new(0.0, 0.6, 0.8)), tangent_map);
+    assert_close(ns_at(&s, from, at), Vec3::new(0.0, 0.6, 0.8), 1e-5);
+    // v running down -y: the bitangent sign flips, so the map's +y is the world's -y.
+    let s = with_map(square(V_FLIPPED), constant(Vec3::new(0.0, 0.6, 0.8)), tangent_map);
+    assert_eq!(s.geometry.meshes[0].tangents.iter().map(|t| t.w).collect::<Vec<_>>(), vec![-1.0; 4]);
+    assert_close(ns_at(&s, from, at), Vec3::new(0.0, -0.6, 0.8), 1e-5);
+    let s = with_map(square(V_FLIPPED), constant(Vec3::new(0.6, 0.0, 0.8)), tangent_map);
+    assert_close(ns_at(&s, from, at), Vec3::new(0.6, 0.0, 0.8), 1e-5);
+}
+
+#[test]
+fn tangent_space_normal_map_on_a_sphere_uses_dpdu() {
+    let mut s = scene();
+    let t = s.add_texture("map", constant(Vec3::new(0.6, 0.0, 0.8)));
+    let m = s.add_material("m", Material::default_diffuse());
+    s.material_perturbations[m.0 as usize] = Some(tangent_map(t));
+    s.geometry.add_sphere(Sphere { center: Vec3::ZERO, radius: 1.0, to_world: Transform::IDENTITY, material: m, emission: Rgb::ZERO });
+    s.build_accel(&BuildOptions::default());
+    // At +x on the equator ∂p/∂u points along -z and ∂p/∂v along +y = n × t.
+    assert_close(ns_at(&s, Vec3::new(3.0, 0.0, 0.0), Vec3::ZERO), Vec3::new(0.8, 0.0, -0.6), 1e-4);
+}
+
+#[test]
+fn flat_normal_map_leaves_interpolated_normals_unchanged() {
+    let mut mesh = square(UP);
+    mesh.normals = [Vec3::new(0.3, 0.0, 1.0), Vec3::new(-0.2, 0.1, 1.0), Vec3::new(0.0, -0.4, 1.0), Vec3::new(0.1, 0.2, 1.0)].map(Vec3::normalize).to_vec();
+    let plain = {
+        let mut s = scene();
+        s.geometry.add_mesh(mesh.clone());
+        s.build_accel(&BuildOptions::default());
+        s
+    };
+    let mapped = with_map(mesh, Texture::Constant(Rgb::new(0.5, 0.5, 1.0)), tangent_map);
+    let mut rng = Pcg32::new(3, 4);
+    for _ in 0..100 {
+        let at = Vec3::new(rng.next_f32(), rng.next_f32(), 0.0);
+        let from = at + Vec3::new(0.1, -0.2, 1.0);
+        assert_close(ns_at(&mapped, from, at), ns_at(&plain, from, at), 1e-5);
+    }
+}
+
+#[test]
+fn object_space_normal_map_follows_the_shape_transform() {
+    // The square turned by 90° about y faces +x; object +x becomes world -z, +z world +x.
+    let to_world = Transform::rotate(Vec3::Y, 90.0).unwrap();
+    let mut mesh = square(UP);
+    mesh.positions = mesh.positions.iter().map(|&p| to_world.point(p)).collect();
+    mesh.object_to_world = to_world;
+    let s = with_map(mesh, constant(Vec3::new(0.6, 0.0, 0.8)), |t| ShadingPerturbation::NormalMap { texture: t, space: NormalSpace::Object });
+    assert_close(ns_at(&s, Vec3::new(2.0, 0.5, -0.5), Vec3::new(0.0, 0.5, -0.5)), Vec3::new(0.8, 0.0, -0.6), 1e-5);
+}
+
+#[test]
+fn bump_map_of_a_linear_ramp_tilts_the_normal() {
+    // Height 0 at u = 0.25 and 1 at u = 0.75 (texel centres), bilinear: slope 2 per unit u.
+    let ramp = ImageTexture::new(2, 1, vec![Rgb::ZERO, Rgb::ONE], Wrap::Clamp, Filter::Bilinear).unwrap();
+    let mut mesh = square(UP);
+    mesh.positions.iter_mut().for_each(|p| *p *= 2.0);
+    let s = with_map(mesh, Texture::Image(ramp), |t| ShadingPerturbation::Bump { texture: t, scale: 0.1 });
+    // ∂p/∂u = (2, 0, 0) + 0.1·2·z, ∂p/∂v = (0, 2, 0): n ∝ (-0.4, 0, 4).
+    let expected = Vec3::new(-0.4, 0.0, 4.0).normalize();
+    assert_close(ns_at(&s, Vec3::new(1.0, 1.0, 3.0), Vec3::new(1.0, 1.0, 0.0)), expected, 1e-3);
+}
+
+#[test]
+fn perturbed_normals_never_leave_the_geometric_hemisphere() {
+    let mut rng = Pcg32::new(11, 2);
+    let extreme = |rng: &mut Pcg32| {
+        let texels = (0..64).map(|_| Rgb::new(rng.next_f32(), rng.next_f32(), rng.next_f32()).map(|c| if c < 0.3 { 0.0 } else if c > 0.7 { 1.0 } else { c })).collect();
+        Texture::Image(ImageTexture::new(8, 8, texels, Wrap::Repeat, Filter::Bilinear).unwrap())
+    };
+    let maps: [fn(TextureId) -> ShadingPerturbation; 3] = [
+        tangent_map,
+        |t| ShadingPerturbation::NormalMap { texture: t, space: NormalSpace::Object },
+        |t| ShadingPerturbation::Bump { texture: t, scale: 50.0 },
+    ];
+    for map in maps {
+        for uvs in [UP, V_FLIPPED] {
+            let s = with_map(square(uvs), extreme(&mut rng), map);
+            for _ in 0..2000 {
+                let at = Vec3::new(rng.next_f32(), rng.next_f32(), 0.0);
+                let hit = s.intersect(&Ray::new(at + Vec3::new(0.3, 0.2, 1.0), Vec3::new(-0.3, -0.2, -1.0)), &mut Counters::default()).unwrap();
+                let (ns, ng) = (hit.geom.ns, hit.geom.ng);
+                assert!((ns.length() - 1.0).abs() < 1e-4, "{ns}");
+                assert!(ns.dot(ng) >= MIN_COS_TO_NG - 1e-4, "ns {ns} ng {ng}");
+            }
+        }
+    }
+    assert_close(keep_above_surface(-Vec3::Z, Vec3::Z), Vec3::Z, 1e-6);
+    let clamped = keep_above_surface(Vec3::new(1.0, 0.0, -1.0).normalize(), Vec3::Z);
+    assert!((clamped.z - MIN_COS_TO_NG).abs() < 1e-6 && clamped.x > 0.99, "{clamped}");
+}
