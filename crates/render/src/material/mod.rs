@@ -52,6 +52,9 @@ pub enum Material {
     /// Cook–Torrance microfacet reflection over a Lambertian base (see `crate::bsdf`):
     /// `f = diffuse/π + specular·D·G·F / (4 cos θi cos θo)`, `roughness` = α.
     CookTorrance { diffuse: TexColor, specular: TexColor, roughness: f32, distribution: Distribution, geometry: MicrofacetGeometry, f0: TexColor },
+    /// Kajiya–Kay hair along the surface's tangent `dpdu` (curves, tubes):
+    /// `f = (color·kd·sin(T, ωi) + ks·cos^exponent θ') / π` (see `crate::bsdf`).
+    Hair { color: TexColor, kd: f32, ks: f32, exponent: f32 },
 }
 
 impl Material {
@@ -67,6 +70,7 @@ impl Material {
             Material::CookTorrance { diffuse, specular, roughness, distribution, geometry, f0 } => {
                 Bsdf::CookTorrance { diffuse: c(diffuse), specular: c(specular), alpha: *roughness, distribution: *distribution, geometry: *geometry, f0: c(f0) }
             }
+            Material::Hair { color, kd, ks, exponent } => Bsdf::KajiyaKay { color: c(color), kd: *kd, ks: *ks, exponent: *exponent },
         }
     }
 
@@ -79,6 +83,7 @@ impl Material {
             Material::Mirror { reflectance } => c(reflectance),
             Material::Dielectric { .. } => Rgb::ONE,
             Material::CookTorrance { diffuse, specular, .. } => c(diffuse) + c(specular),
+            Material::Hair { color, .. } => c(color),
         }
     }
 
@@ -93,6 +98,7 @@ impl Material {
             Material::Mirror { .. } => "mirror",
             Material::Dielectric { .. } => "dielectric",
             Material::CookTorrance { .. } => "cooktorrance",
+            Material::Hair { .. } => "hair",
         }
     }
 }
