@@ -1,6 +1,7 @@
 //! Tessellation of a strand into a closed triangle tube: rings of `sides` vertices at
 //! `segments` steps along each Bézier segment, oriented by rotation-minimising frames so
-//! the tube neither twists nor flips (a Frenet frame flips at every inflection point).
+//! the tube neither twists nor flips (a Frenet frame flips at every inflection point),
+//! closed by hemispheres like the round ends of direct intersection.
 
 use raylab_core::{Frame, Vec3};
 
@@ -31,12 +32,12 @@ pub fn rotation_minimising_normals(points: &[Vec3], tangents: &[Vec3]) -> Vec<Ve
 }
 
 /// A closed tube around the strand `segments` (Bézier segments joined end to end):
-/// `steps` rings per segment, `sides` vertices per ring, a flat cap at each end whose
-/// centre vertex closes the fan. Every vertex is shared, so every edge belongs to exactly
-/// two triangles (watertight). Vertex normals are the rings' radial directions (the cap
-/// centres' the end tangents). Triangles are ordered so that `p1 - p0` runs along the
-/// strand: without UVs a mesh's `dpdu` is `p1 - p0`, which gives the hair material its
-/// fibre direction.
+/// `steps` rings per segment, `sides` vertices per ring, and a hemisphere at each end
+/// (rings at `sides / 4` latitudes and a pole), the round ends of direct intersection.
+/// Every vertex is shared, so every edge belongs to exactly two triangles (watertight).
+/// Vertex normals are the exact normals of the round tube. Triangles are ordered so that
+/// `p1 - p0` runs along the strand: without UVs a mesh's `dpdu` is `p1 - p0`, which gives
+/// the hair material its fibre direction.
 pub fn tessellate(segments: &[Bezier], steps: u32, sides: u32, material: MaterialId) -> TriangleMesh {
     let (steps, sides) = (steps.max(1), sides.max(3));
     let mut samples = Vec::new();
@@ -59,31 +60,48 @@ pub fn tessellate(segments: &[Bezier], steps: u32, sides: u32, material: Materia
     let normals = rotation_minimising_normals(&points, &tangents);
 
     let mut mesh = TriangleMesh { name: "curve".into(), material, ..Default::default() };
-    for i in 0..n {
-        let (r, t) = (normals[i], tangents[i]);
-        let s = t.cross(r);
+    // A ring around `centre` in the plane of the frame of sample `i`, its normals tilted
+    // by `latitude` towards `t` (an end's outward tangent).
+    let add_ring = |mesh: &mut TriangleMesh, i: usize, centre: Vec3, radius: f32, t: Vec3, latitude: f32| {
+        let first = mesh.positions.len() as u32;
+        let (r, s) = (normals[i], tangents[i].cross(normals[i]));
         for k in 0..sides {
             let phi = 2.0 * std::f32::consts::PI * k as f32 / sides as f32;
             let radial = phi.cos() * r + phi.sin() * s;
-            mesh.positions.push(points[i] + samples[i].0.w * radial);
-            mesh.normals.push(radial);
+            mesh.positions.push(centre + radius * radial);
+            mesh.normals.push(latitude.cos() * radial + latitude.sin() * t);
         }
-    }
-    let ring = |i: usize, k: u32| (i as u32) * sides + k % sides;
-    for i in 0..n - 1 {
+        first
+    };
+    let side_rings: Vec<u32> = (0..n).map(|i| add_ring(&mut mesh, i, points[i], samples[i].0.w, tangents[i], 0.0)).collect();
+    let latitudes = (sides / 4).max(1);
+    let cap = |mesh: &mut TriangleMesh, i: usize, dir: f32| -> (Vec<u32>, u32) {
+        let (centre, radius, t) = (points[i], samples[i].0.w, dir * tangents[i]);
+        let rings = (1..latitudes).map(|j| {
+            let a = std::f32::consts::FRAC_PI_2 * j as f32 / latitudes as f32;
+            add_ring(mesh, i, centre + radius * a.sin() * t, radius * a.cos(), t, a)
+        }).collect();
+        mesh.positions.push(centre + radius * t);
+        mesh.normals.push(t);
+        (rings, mesh.positions.len() as u32 - 1)
+    };
+    let (start_rings, start_pole) = cap(&mut mesh, 0, -1.0);
+    let (end_rings, end_pole) = cap(&mut mesh, n - 1, 1.0);
+    // Every ring from the start pole to the end pole, in order along the strand.
+    let rings: Vec<u32> = start_rings.iter().rev().chain(&side_rings).chain(&end_rings).copied().collect();
+    let at = |ring: u32, k: u32| ring + k % sides;
+    for pair in rings.windows(2) {
         for k in 0..sides {
-            let (a, b, c, d) = (ring(i, k), ring(i + 1, k), ring(i + 1, k + 1), ring(i, k + 1));
+            let (a, b, c, d) = (at(pair[0], k), at(pair[1], k), at(pair[1], k + 1), at(pair[0], k + 1));
             // Outward winding, with the first edge along the strand (see above).
             mesh.indices.push([b, a, c]);
             mesh.indices.push([d, c, a]);
         }
     }
-    let start = mesh.positions.len() as u32;
-    mesh.positions.extend([points[0], points[n - 1]]);
-    mesh.normals.extend([-tangents[0], tangents[n - 1]]);
+    let (first, last) = (rings[0], rings[rings.len() - 1]);
     for k in 0..sides {
-        mesh.indices.push([start, ring(0, k + 1), ring(0, k)]);
-        mesh.indices.push([start + 1, ring(n - 1, k), ring(n - 1, k + 1)]);
+        mesh.indices.push([start_pole, at(first, k + 1), at(first, k)]);
+        mesh.indices.push([end_pole, at(last, k), at(last, k + 1)]);
     }
     mesh
 }
@@ -107,7 +125,8 @@ mod tests {
     fn tubes_are_closed() {
         for (steps, sides) in [(2, 3), (4, 4), (8, 16)] {
             let mesh = tessellate(&s_curve(), steps, sides, MaterialId::default());
-            let rings = 2 * steps + 1;
+            // Side rings, then `sides / 4 - 1` more rings and a pole on each hemisphere.
+            let rings = 2 * steps + 1 + 2 * ((sides / 4).max(1) - 1);
             assert_eq!(mesh.len() as u32, 2 * sides * (rings - 1) + 2 * sides);
             let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
             for t in &mesh.indices {
@@ -125,7 +144,7 @@ mod tests {
                 }
             }
             // The winding faces outwards: positive signed volume (divergence theorem),
-            // close to Pappus' π r² L once the tube is fine.
+            // close to Pappus' π r² L plus a ball for the two ends once the tube is fine.
             let volume: f32 = (0..mesh.len() as u32).map(|t| {
                 let [a, b, c] = mesh.vertices(t);
                 a.dot(b.cross(c)) / 6.0
@@ -133,8 +152,8 @@ mod tests {
             assert!(volume > 0.0, "steps {steps} sides {sides}: the tube is inside out ({volume})");
             if sides == 16 {
                 let length: f32 = s_curve().iter().map(|s| (0..1000).map(|j| (s.point((j + 1) as f32 / 1000.0) - s.point(j as f32 / 1000.0)).length()).sum::<f32>()).sum();
-                let pappus = std::f32::consts::PI * 0.01 * length;
-                assert!((volume / pappus - 1.0).abs() < 0.05, "volume {volume} vs π r² L = {pappus}");
+                let pappus = std::f32::consts::PI * (0.01 * length + 4.0 / 3.0 * 0.001);
+                assert!((volume / pappus - 1.0).abs() < 0.05, "volume {volume} vs π r² L + 4/3 π r³ = {pappus}");
             }
         }
     }
