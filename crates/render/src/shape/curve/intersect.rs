@@ -104,7 +104,11 @@ impl Search {
         let (ra, rb) = (cp[0].w, cp[3].w);
         let axis = b - a;
         self.sphere(a, ra, axis, zc, u0);
-        self.sphere(b, rb, axis, zc, u1);
+        // The sphere at `b` is the next leaf's first, and lies in that leaf's box: only
+        // the segment's last one needs testing here.
+        if u1 == 1.0 {
+            self.sphere(b, rb, axis, zc, u1);
+        }
         self.frustum(a, b, ra, rb, zc, u0, u1);
     }
 
