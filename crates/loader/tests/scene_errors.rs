@@ -109,7 +109,8 @@ fn example_scenes_and_default_scene_parse() {
         let p = entry.unwrap().path();
         if p.extension().is_some_and(|e| e == "toml") {
             let scene = load_scene(&p, &Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
-            assert!(!scene.geometry.meshes.is_empty() || !scene.geometry.spheres.is_empty(), "{}", p.display());
+            let g = &scene.geometry;
+            assert!(!g.meshes.is_empty() || !g.spheres.is_empty() || !g.curves.is_empty(), "{}", p.display());
             n += 1;
         }
     }

@@ -52,6 +52,11 @@ impl Curve {
         self.segments.is_empty()
     }
 
+    /// Bytes of the segments and their prepared cubics.
+    pub fn memory_bytes(&self) -> usize {
+        self.segments.len() * std::mem::size_of::<Bezier>() + self.cubics.len() * std::mem::size_of::<([Vec4; 4], u32)>()
+    }
+
     /// Bounds of segment `seg`'s tube, grown a little for the intersector's rounding so
     /// that no structure's box test rejects a hit the segment reports.
     pub fn segment_bounds(&self, seg: u32) -> Aabb {
