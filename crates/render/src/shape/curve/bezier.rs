@@ -58,8 +58,8 @@ impl Bezier {
     pub fn derivative(&self, u: f32) -> Vec4 {
         let n = self.degree;
         let mut d = [Vec4::ZERO; 4];
-        for i in 0..n {
-            d[i] = n as f32 * (self.cp[i + 1] - self.cp[i]);
+        for (i, di) in d.iter_mut().enumerate().take(n) {
+            *di = n as f32 * (self.cp[i + 1] - self.cp[i]);
         }
         if n == 1 {
             return d[0];
@@ -153,7 +153,7 @@ pub fn to_bezier_segments(basis: Basis, degree: usize, points: &[Vec4]) -> Resul
     let seg = |cp: &[Vec4]| Bezier::new(cp).expect("2 to 4 control points");
     match basis {
         Basis::Bezier => {
-            if n < degree + 1 || (n - 1) % degree != 0 {
+            if n < degree + 1 || !(n - 1).is_multiple_of(degree) {
                 return Err(format!("a Bézier curve of degree {degree} needs {degree}·k + 1 points, found {n}"));
             }
             Ok((0..(n - 1) / degree).map(|k| seg(&points[k * degree..=k * degree + degree])).collect())

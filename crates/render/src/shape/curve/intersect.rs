@@ -38,9 +38,7 @@ pub fn subdivision_depth(cp: &[Vec4; 4]) -> u32 {
     if l0 == 0.0 {
         return 0;
     }
-    if !(eps > 0.0) {
-        return MAX_DEPTH;
-    }
+    // A zero radius makes the ratio infinite: the deepest level.
     let depth = ((0.75 * l0 / eps).log2() / 2.0).ceil();
     depth.clamp(0.0, MAX_DEPTH as f32) as u32
 }
