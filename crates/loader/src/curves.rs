@@ -45,7 +45,7 @@ pub fn add_curves(scene: &mut Scene, t: &Table, file: Option<(Val, Found)>, mate
         }
         (None, Some((fv, found))) => {
             let path = found.path();
-            let is_hair = path.to_string_lossy().ends_with(".hair");
+            let is_hair = path.to_string_lossy().trim_end_matches(".gz").ends_with(".hair");
             let default_radius = match &radius_v {
                 Some(v) if is_hair => return Err(v.err("not used with .hair files, which give every point's thickness")),
                 Some(v) => non_negative(v, v.f32()?)?,
