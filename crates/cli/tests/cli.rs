@@ -147,6 +147,14 @@ fn generated_scenes_have_the_expected_size() {
     let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     // A Sierpinski tetrahedron of depth 3: 4³ tetrahedra of 4 triangles, plus the 2-triangle floor.
     assert_eq!(j["counts"]["triangles"], 4 * 64 + 2, "{j}");
+    // A furry ball: the curves go beside the scene, one primitive per segment.
+    let o = raylab(&["gen", "hair", "--strands", "30", "--segments", "3", "-o", "fur.toml"], &dir);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(dir.join("fur.curves").is_file());
+    let o = raylab(&["inspect", "fur.toml", "--json"], &dir);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!((j["counts"]["curves"].as_u64(), j["counts"]["curve_segments"].as_u64(), j["counts"]["primitives"].as_u64()), (Some(30), Some(90), Some(91)), "{j}");
 }
 
 #[test]

@@ -16,7 +16,7 @@ pub mod transform;
 pub use bounds::{Aabb, BoundingSphere};
 pub use distribution::{Distribution1D, Distribution2D};
 pub use frame::Frame;
-pub use glam::{Vec2, Vec3};
+pub use glam::{Vec2, Vec3, Vec4};
 pub use offset::{gamma, offset_ray_origin};
 pub use ray::Ray;
 pub use rng::Pcg32;

@@ -2,6 +2,7 @@
 //! gzipped or not), textures and output images. Every error names the file, the line and
 //! the field.
 
+mod curves;
 pub mod error;
 pub mod files;
 pub mod image_io;

@@ -61,12 +61,12 @@ const RENDER: &[&str] = &["spp", "sampler", "max_depth", "integrator", "light_sa
 const BACKGROUND: &[&str] = &["color", "texture"];
 const TEXTURE: &[&str] = &["name", "type", "file", "wrap", "filter", "srgb", "scale", "even", "odd", "space", "kind", "colors", "octaves", "seed", "color"];
 const MATERIAL: &[&str] = &[
-    "name", "type", "albedo", "ka", "kd", "ks", "exponent", "reflectance", "ior", "diffuse", "specular", "roughness", "distribution", "geometry", "f0", "metal", "eta", "k", "normal_map",
-    "normal_space", "bump_map", "bump_scale",
+    "name", "type", "albedo", "ka", "kd", "ks", "exponent", "reflectance", "ior", "diffuse", "specular", "roughness", "distribution", "geometry", "f0", "metal", "eta", "k", "color",
+    "normal_map", "normal_space", "bump_map", "bump_scale",
 ];
 /// Fields every material kind has.
 const MATERIAL_COMMON: &[&str] = &["name", "type", "normal_map", "normal_space", "bump_map", "bump_scale"];
-const SHAPE: &[&str] = &["type", "material", "transform", "center", "radius", "vertices", "normals", "uvs", "file", "smooth"];
+const SHAPE: &[&str] = &["type", "material", "transform", "center", "radius", "vertices", "normals", "uvs", "file", "smooth", "points", "basis", "degree", "mode", "segments", "sides"];
 const LIGHT: &[&str] = &["type", "position", "intensity", "direction", "irradiance", "vertices", "radiance", "texture", "center", "radius", "n", "file", "scale"];
 const TRANSFORM_STEP: &[&str] = &["scale", "rotate", "translate"];
 const ROTATE: &[&str] = &["axis", "degrees"];
@@ -136,7 +136,7 @@ fn positive(v: &Val, x: f32) -> Result<f32, LoadError> {
     }
 }
 
-fn in_range(v: &Val, x: i64, lo: i64, hi: i64) -> Result<i64, LoadError> {
+pub(crate) fn in_range(v: &Val, x: i64, lo: i64, hi: i64) -> Result<i64, LoadError> {
     if (lo..=hi).contains(&x) {
         Ok(x)
     } else {
@@ -327,13 +327,14 @@ impl Builder<'_> {
         if self.material_ids.contains_key(&name) {
             return Err(name_v.err(format!("a material named `{name}` already exists")));
         }
-        let kind = t.type_name(&["diffuse", "phong", "mirror", "dielectric", "cooktorrance", "conductor"])?;
+        let kind = t.type_name(&["diffuse", "phong", "mirror", "dielectric", "cooktorrance", "conductor", "hair"])?;
         let valid: &[&str] = match kind {
             "diffuse" => &["albedo"],
             "phong" => &["ka", "kd", "ks", "exponent"],
             "mirror" => &["reflectance"],
             "cooktorrance" => &["diffuse", "specular", "roughness", "distribution", "geometry", "f0"],
             "conductor" => &["metal", "eta", "k", "roughness", "distribution", "geometry"],
+            "hair" => &["color", "kd", "ks", "exponent"],
             _ => &["ior"],
         };
         for k in MATERIAL {
@@ -374,6 +375,12 @@ impl Builder<'_> {
                 let (eta, k) = self.metal(t)?;
                 Material::Conductor { eta, k, roughness: roughness()?.unwrap_or(0.1), distribution: distribution()?.unwrap_or(Distribution::Ggx), geometry: geometry()?.unwrap_or(MicrofacetGeometry::Smith) }
             }
+            "hair" => Material::Hair {
+                color: color("color", Rgb::new(0.35, 0.2, 0.1))?,
+                kd: t.opt("kd", |v| in_range_f32(v, v.f32()?, 0.0, 1.0))?.unwrap_or(0.8),
+                ks: t.opt("ks", |v| in_range_f32(v, v.f32()?, 0.0, 1.0))?.unwrap_or(0.2),
+                exponent: t.opt("exponent", |v| in_range_f32(v, v.f32()?, 0.0, 10000.0))?.unwrap_or(40.0),
+            },
             _ => Material::Dielectric { ior: t.opt("ior", |v| positive(v, v.f32()?))?.unwrap_or(1.5) },
         };
         let perturbation = self.perturbation(t)?;
@@ -498,11 +505,12 @@ impl Builder<'_> {
     }
 
     fn shape(&mut self, scene: &mut Scene, t: &Table) -> Result<(), LoadError> {
-        let kind = t.type_name(&["sphere", "triangle", "quad", "mesh"])?;
+        let kind = t.type_name(&["sphere", "triangle", "quad", "mesh", "curve"])?;
         let valid: &[&str] = match kind {
             "sphere" => &["center", "radius"],
             "triangle" => &["vertices", "normals", "uvs"],
             "quad" => &["vertices", "uvs"],
+            "curve" => crate::curves::KEYS,
             _ => &["file", "smooth"],
         };
         for k in SHAPE {
@@ -548,6 +556,10 @@ impl Builder<'_> {
                     None => {}
                 }
                 scene.geometry.add_mesh(mesh);
+            }
+            "curve" => {
+                let file = t.get("file").map(|fv| self.find(&fv).map(|found| (fv, found))).transpose()?;
+                crate::curves::add_curves(scene, t, file, mat, &to_world)?;
             }
             _ => {
                 let fv = t.req("file")?;

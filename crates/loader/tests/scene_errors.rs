@@ -36,7 +36,7 @@ fn unknown_keys_and_types_list_the_valid_ones() {
     );
     assert_eq!(
         error_of(&format!("{CAMERA}[[shapes]]\ntype = \"cylinder\"\n")),
-        "bad.toml:6: shapes[0].type: unknown type `cylinder` (valid: sphere, triangle, quad, mesh)"
+        "bad.toml:6: shapes[0].type: unknown type `cylinder` (valid: sphere, triangle, quad, mesh, curve)"
     );
     assert_eq!(
         error_of(&format!("{CAMERA}[[shapes]]\ntype = \"sphere\"\nradius = 1\nvertices = [[0, 0, 0]]\n")),
@@ -110,7 +110,8 @@ fn example_scenes_and_default_scene_parse() {
         let p = entry.unwrap().path();
         if p.extension().is_some_and(|e| e == "toml") {
             let scene = load_scene(&p, &Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
-            assert!(!scene.geometry.meshes.is_empty() || !scene.geometry.spheres.is_empty(), "{}", p.display());
+            let g = &scene.geometry;
+            assert!(!g.meshes.is_empty() || !g.spheres.is_empty() || !g.curves.is_empty(), "{}", p.display());
             n += 1;
         }
     }

@@ -1,5 +1,6 @@
-//! `raylab gen`: procedural scenes of any size (Haines' SPD), written as a scene file and,
-//! for triangle-heavy scenes, an OBJ mesh beside it.
+//! `raylab gen`: procedural scenes of any size (Haines' SPD, and a furry ball of curves),
+//! written as a scene file and, for triangle-heavy or hairy scenes, an OBJ mesh or a
+//! curve file beside it.
 
 use std::path::PathBuf;
 
@@ -8,25 +9,32 @@ use clap::Args;
 
 #[derive(Args, Clone, Debug)]
 pub struct GenArgs {
-    /// Which scene: balls (sphereflake), rings, tetra (Sierpinski tetrahedron), mount (fractal mountain)
+    /// Which scene: balls (sphereflake), rings, tetra (Sierpinski tetrahedron), mount (fractal mountain), hair (furry ball of curves)
     pub kind: String,
     /// Recursion depth or level (balls 1-6, rings 1-64, tetra 1-10, mount 1-11)
     #[arg(long, default_value_t = 3)]
     pub size: u32,
-    /// Scene file to write; a mesh goes beside it with the same stem and `.obj`
+    /// Strands of `hair` (1-1000000)
+    #[arg(long, default_value_t = 1000)]
+    pub strands: u32,
+    /// Cubic curve segments per strand of `hair` (1-64)
+    #[arg(long, default_value_t = 4)]
+    pub segments: u32,
+    /// Scene file to write; a mesh (`.obj`) or curves (`.curves`) go beside it with the same stem
     #[arg(short, long)]
     pub output: PathBuf,
 }
 
 pub fn run(a: &GenArgs) -> Result<()> {
     let stem = a.output.file_stem().and_then(|s| s.to_str()).context("--output: needs a file name")?;
-    let mesh_name = format!("{stem}.obj");
-    let g = raylab_procedural::generate(&a.kind, a.size, &mesh_name).map_err(anyhow::Error::msg)?;
+    let side_name = format!("{stem}.{}", if a.kind == "hair" { "curves" } else { "obj" });
+    let size = raylab_procedural::Size { size: a.size, strands: a.strands, segments: a.segments };
+    let g = raylab_procedural::generate(&a.kind, size, &side_name).map_err(anyhow::Error::msg)?;
     std::fs::write(&a.output, &g.toml).with_context(|| format!("{}: cannot write", a.output.display()))?;
-    if let Some(obj) = &g.obj {
-        let mesh_path = a.output.with_file_name(&mesh_name);
-        std::fs::write(&mesh_path, obj).with_context(|| format!("{}: cannot write", mesh_path.display()))?;
+    if let Some(text) = &g.side_file {
+        let side_path = a.output.with_file_name(&side_name);
+        std::fs::write(&side_path, text).with_context(|| format!("{}: cannot write", side_path.display()))?;
     }
-    eprintln!("Wrote {} ({} spheres, {} triangles).", a.output.display(), g.spheres, g.triangles);
+    eprintln!("Wrote {} ({} spheres, {} triangles, {} curve segments).", a.output.display(), g.spheres, g.triangles, g.curve_segments);
     Ok(())
 }

@@ -96,7 +96,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             let c = &output.counters;
             let per_ray = |n: u64| n as f64 / c.rays.max(1) as f64;
             eprintln!(
-                "Rendered {} at {}×{}, {} spp ({}), integrator {}, max depth {}: {} primitives ({} triangles, {} spheres), {} lights; \
+                "Rendered {} at {}×{}, {} spp ({}), integrator {}, max depth {}: {} primitives ({} triangles, {} spheres, {} curve segments), {} lights; \
                  {} acceleration structure built in {:.1} ms after {:.2} s of loading. Traced {:.2} M rays in {:.2} s ({:.2} Mrays/s on {threads} threads){}; per ray {:.1} nodes visited and {:.1} primitive tests. Wrote {}.",
                 a.scene.scene_name(),
                 s.width,
@@ -108,6 +108,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
                 g.len(),
                 g.triangle_count(),
                 g.spheres.len(),
+                g.curves.iter().map(|c| c.len()).sum::<usize>(),
                 scene.lights.len() + scene.area_lights.len() + scene.environment.is_some() as usize,
                 stats.name,
                 stats.build_ms,

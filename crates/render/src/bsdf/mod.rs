@@ -7,7 +7,7 @@
 //! lobes, where `pdf` is the discrete probability of the chosen lobe and `f` includes
 //! `1/|cos θi|` so that `f·|cos θi|/pdf` is the lobe's weight.
 //!
-//! The opaque models (Lambert, Phong, CookTorrance, Mirror) are one-sided: they reflect only
+//! The opaque models (Lambert, Phong, CookTorrance, KajiyaKay, Mirror) are one-sided: they reflect only
 //! when `wo.z > 0` and `wi.z > 0`. An integrator shading a two-sided surface flips the frame
 //! to `wo`'s side first, as the Whitted integrator does with its `facing` normal.
 //! `Dielectric` is two-sided: `wo.z < 0` means `wo` is inside the medium.
@@ -15,6 +15,7 @@
 mod cook_torrance;
 mod dielectric;
 mod fresnel;
+mod kajiya_kay;
 mod lambert;
 mod microfacet;
 mod mirror;
@@ -23,6 +24,7 @@ mod phong;
 mod tests;
 
 pub use fresnel::{fresnel_dielectric, reflect, refract, Fresnel};
+pub use kajiya_kay::fibre_frame;
 pub use microfacet::{Distribution, Geometry};
 
 use raylab_core::color::luminance;
@@ -44,6 +46,9 @@ pub enum Bsdf {
     /// Cook–Torrance microfacet reflection plus a Lambertian base, see `cook_torrance.rs`.
     /// `alpha` is the roughness (for Beckmann the RMS slope), clamped to ≥ 1e-3.
     CookTorrance { diffuse: Rgb, specular: Rgb, alpha: f32, distribution: Distribution, geometry: Geometry, fresnel: Fresnel },
+    /// Kajiya–Kay hair, see `kajiya_kay.rs`; the local x axis is the fibre's tangent
+    /// ([`fibre_frame`]).
+    KajiyaKay { color: Rgb, kd: f32, ks: f32, exponent: f32 },
 }
 
 /// One sampled direction with the BSDF value and density there.
@@ -66,6 +71,7 @@ impl Bsdf {
             Bsdf::CookTorrance { diffuse, specular, alpha, distribution, geometry, fresnel } => {
                 cook_torrance::CookTorrance { diffuse, specular, alpha, distribution, geometry, fresnel }.eval(wo, wi)
             }
+            Bsdf::KajiyaKay { color, kd, ks, exponent } => kajiya_kay::KajiyaKay { color, kd, ks, exponent }.eval(wo, wi),
             Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } => Rgb::ZERO,
         }
     }
@@ -78,6 +84,7 @@ impl Bsdf {
             Bsdf::CookTorrance { diffuse, specular, alpha, distribution, geometry, fresnel } => {
                 cook_torrance::CookTorrance { diffuse, specular, alpha, distribution, geometry, fresnel }.pdf(wo, wi)
             }
+            Bsdf::KajiyaKay { color, kd, ks, exponent } => kajiya_kay::KajiyaKay { color, kd, ks, exponent }.pdf(wo, wi),
             Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } => 0.0,
         }
     }
@@ -92,6 +99,7 @@ impl Bsdf {
             Bsdf::CookTorrance { diffuse, specular, alpha, distribution, geometry, fresnel } => {
                 cook_torrance::CookTorrance { diffuse, specular, alpha, distribution, geometry, fresnel }.sample(wo, u_lobe, u)?
             }
+            Bsdf::KajiyaKay { color, kd, ks, exponent } => kajiya_kay::KajiyaKay { color, kd, ks, exponent }.sample(wo, u)?,
             Bsdf::Mirror { reflectance } => return mirror::sample(reflectance, wo),
             Bsdf::Dielectric { ior } => return dielectric::sample(ior, wo, u_lobe),
         };

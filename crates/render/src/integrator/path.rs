@@ -13,7 +13,7 @@ use raylab_accel::Counters;
 use raylab_core::color::luminance;
 use raylab_core::{Frame, Ray, Rgb, Vec2, Vec3};
 
-use crate::bsdf::Bsdf;
+use crate::bsdf::{fibre_frame, Bsdf};
 use crate::light::LightSampling;
 use crate::sampler::PixelSampler;
 use crate::scene::SurfaceHit;
@@ -21,7 +21,7 @@ use crate::Scene;
 
 /// The shading frame at a hit: for opaque BSDFs the shading normal turned towards `wo`
 /// (two-sided surfaces); for dielectrics oriented like the geometric normal, so that the
-/// local `wo.z < 0` means "inside".
+/// local `wo.z < 0` means "inside". Hair puts the fibre's tangent on the local x axis.
 fn shading_frame(hit: &SurfaceHit, bsdf: &Bsdf, wo: Vec3) -> Frame {
     let g = &hit.geom;
     let n = match bsdf {
@@ -40,7 +40,10 @@ fn shading_frame(hit: &SurfaceHit, bsdf: &Bsdf, wo: Vec3) -> Frame {
             }
         }
     };
-    Frame::from_z(n)
+    match bsdf {
+        Bsdf::KajiyaKay { .. } => fibre_frame(n, g.dpdu),
+        _ => Frame::from_z(n),
+    }
 }
 
 pub(super) fn radiance(scene: &Scene, camera_ray: &Ray, sampler: &mut PixelSampler, c: &mut Counters, direct_only: bool) -> Rgb {

@@ -10,7 +10,7 @@ use raylab_core::{Frame, Ray, Rgb, Vec2, Vec3};
 use crate::sampler::PixelSampler;
 
 use crate::light::Light;
-use crate::bsdf::{fresnel_dielectric, reflect, refract};
+use crate::bsdf::{fibre_frame, fresnel_dielectric, reflect, refract};
 use crate::material::Material;
 use crate::scene::SurfaceHit;
 use crate::Scene;
@@ -47,6 +47,13 @@ pub(super) fn radiance(scene: &Scene, ray: &Ray, depth: u32, sampler: &mut Pixel
             // Microfacet reflection of the delta lights, by the physically based BSDF.
             let bsdf = m.bsdf(tex, g.uv, g.p);
             let frame = Frame::from_z(facing(g.ns, wo));
+            let wo_local = frame.to_local(wo);
+            direct(scene, &hit, wo, sampler, c, |wi, _n| bsdf.eval(wo_local, frame.to_local(wi)))
+        }
+        m @ Material::Hair { .. } => {
+            // Kajiya–Kay needs the fibre's direction: the frame's x is the tangent.
+            let bsdf = m.bsdf(tex, g.uv, g.p);
+            let frame = fibre_frame(facing(g.ns, wo), g.dpdu);
             let wo_local = frame.to_local(wo);
             direct(scene, &hit, wo, sampler, c, |wi, _n| bsdf.eval(wo_local, frame.to_local(wi)))
         }

@@ -55,6 +55,9 @@ pub enum Material {
     /// Rough metal (pbrt-v4's `conductor`): the same microfacet reflection with the exact
     /// Fresnel reflectance of complex index `eta + i·k` per channel and no diffuse base.
     Conductor { eta: Rgb, k: Rgb, roughness: f32, distribution: Distribution, geometry: MicrofacetGeometry },
+    /// Kajiya–Kay hair along the surface's tangent `dpdu` (curves, tubes):
+    /// `f = (color·kd·sin(T, ωi) + ks·cos^exponent θ') / π` (see `crate::bsdf`).
+    Hair { color: TexColor, kd: f32, ks: f32, exponent: f32 },
 }
 
 /// Complex refractive indices `(eta, k)` of common metals at the R, G and B primaries
@@ -82,6 +85,7 @@ impl Material {
             Material::Conductor { eta, k, roughness, distribution, geometry } => {
                 Bsdf::CookTorrance { diffuse: Rgb::ZERO, specular: Rgb::ONE, alpha: *roughness, distribution: *distribution, geometry: *geometry, fresnel: Fresnel::Conductor { eta: *eta, k: *k } }
             }
+            Material::Hair { color, kd, ks, exponent } => Bsdf::KajiyaKay { color: c(color), kd: *kd, ks: *ks, exponent: *exponent },
         }
     }
 
@@ -95,6 +99,7 @@ impl Material {
             Material::Dielectric { .. } => Rgb::ONE,
             Material::CookTorrance { diffuse, specular, .. } => c(diffuse) + c(specular),
             Material::Conductor { eta, k, .. } => Fresnel::Conductor { eta: *eta, k: *k }.eval(1.0),
+            Material::Hair { color, .. } => c(color),
         }
     }
 
@@ -110,6 +115,7 @@ impl Material {
             Material::Dielectric { .. } => "dielectric",
             Material::CookTorrance { .. } => "cooktorrance",
             Material::Conductor { .. } => "conductor",
+            Material::Hair { .. } => "hair",
         }
     }
 }

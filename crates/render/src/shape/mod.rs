@@ -1,11 +1,13 @@
 //! Shapes and the scene's geometry: the list of primitives that acceleration structures
 //! index into.
 
+pub mod curve;
 mod mesh;
 mod sphere;
 
 use std::ops::Range;
 
+pub use curve::Curve;
 pub use mesh::TriangleMesh;
 pub use sphere::Sphere;
 
@@ -37,6 +39,8 @@ pub struct SurfaceGeometry {
 pub enum PrimRef {
     Triangle { mesh: u32, tri: u32 },
     Sphere(u32),
+    /// One Bézier segment of a strand.
+    Curve { curve: u32, seg: u32 },
 }
 
 /// All shapes of a scene, flattened into primitives. Each shape's primitives are
@@ -45,6 +49,7 @@ pub enum PrimRef {
 pub struct Geometry {
     pub meshes: Vec<TriangleMesh>,
     pub spheres: Vec<Sphere>,
+    pub curves: Vec<Curve>,
     prims: Vec<PrimRef>,
     objects: Vec<Range<u32>>,
 }
@@ -66,6 +71,14 @@ impl Geometry {
         self.spheres.push(sphere);
     }
 
+    pub fn add_curve(&mut self, curve: Curve) {
+        let c = self.curves.len() as u32;
+        let start = self.prims.len() as u32;
+        self.prims.extend((0..curve.len() as u32).map(|seg| PrimRef::Curve { curve: c, seg }));
+        self.objects.push(start..self.prims.len() as u32);
+        self.curves.push(curve);
+    }
+
     pub fn prim(&self, i: u32) -> PrimRef {
         self.prims[i as usize]
     }
@@ -78,6 +91,7 @@ impl Geometry {
         match self.prims[prim as usize] {
             PrimRef::Triangle { mesh, .. } => self.meshes[mesh as usize].material,
             PrimRef::Sphere(s) => self.spheres[s as usize].material,
+            PrimRef::Curve { curve, .. } => self.curves[curve as usize].material,
         }
     }
 
@@ -86,6 +100,7 @@ impl Geometry {
         match self.prims[prim as usize] {
             PrimRef::Triangle { mesh, tri } => self.meshes[mesh as usize].surface(tri, u, v),
             PrimRef::Sphere(s) => self.spheres[s as usize].surface(ray, t),
+            PrimRef::Curve { curve, seg } => self.curves[curve as usize].surface(seg, ray, t, u, v),
         }
     }
 
@@ -106,6 +121,8 @@ impl Geometry {
         let to_world = match self.prims[prim as usize] {
             PrimRef::Triangle { mesh, .. } => &self.meshes[mesh as usize].object_to_world,
             PrimRef::Sphere(s) => &self.spheres[s as usize].to_world,
+            // Curves are stored in world space.
+            PrimRef::Curve { .. } => return n.try_normalize().unwrap_or(n),
         };
         to_world.normal(n).try_normalize().unwrap_or(n)
     }
@@ -115,6 +132,7 @@ impl Geometry {
         match self.prims[prim as usize] {
             PrimRef::Triangle { mesh, .. } => self.meshes[mesh as usize].emission,
             PrimRef::Sphere(s) => self.spheres[s as usize].emission,
+            PrimRef::Curve { .. } => Rgb::ZERO,
         }
     }
 
@@ -122,7 +140,7 @@ impl Geometry {
     pub fn emission_texture(&self, prim: u32) -> Option<TextureId> {
         match self.prims[prim as usize] {
             PrimRef::Triangle { mesh, .. } => self.meshes[mesh as usize].emission_texture,
-            PrimRef::Sphere(_) => None,
+            PrimRef::Sphere(_) | PrimRef::Curve { .. } => None,
         }
     }
 
@@ -138,7 +156,7 @@ impl Geometry {
                 let [a, b, c] = m.indices[tri as usize].map(|i| m.uvs[i as usize]);
                 (1.0 - b1 - b2) * a + b1 * b + b2 * c
             }
-            PrimRef::Sphere(_) => Vec2::ZERO,
+            PrimRef::Sphere(_) | PrimRef::Curve { .. } => Vec2::ZERO,
         }
     }
 
@@ -152,7 +170,7 @@ impl Geometry {
         }
         let n = match self.prims[prim as usize] {
             PrimRef::Triangle { mesh, tri } => self.meshes[mesh as usize].winding_normal(tri),
-            PrimRef::Sphere(_) => geom.ng,
+            PrimRef::Sphere(_) | PrimRef::Curve { .. } => geom.ng,
         };
         if n.dot(w) > 0.0 { le } else { Rgb::ZERO }
     }
@@ -171,6 +189,7 @@ impl Primitives for Geometry {
         match self.prims[i as usize] {
             PrimRef::Triangle { mesh, tri } => self.meshes[mesh as usize].triangle_bounds(tri),
             PrimRef::Sphere(s) => self.spheres[s as usize].bounds(),
+            PrimRef::Curve { curve, seg } => self.curves[curve as usize].segment_bounds(seg),
         }
     }
 
@@ -179,6 +198,7 @@ impl Primitives for Geometry {
         match self.prims[i as usize] {
             PrimRef::Triangle { mesh, tri } => self.meshes[mesh as usize].intersect(tri, ray).map(|(t, u, v)| PrimHit { t, u, v }),
             PrimRef::Sphere(s) => self.spheres[s as usize].intersect(ray).map(|t| PrimHit { t, u: 0.0, v: 0.0 }),
+            PrimRef::Curve { curve, seg } => self.curves[curve as usize].intersect(seg, ray).map(|h| PrimHit { t: h.t, u: h.u, v: h.v }),
         }
     }
 

@@ -1,0 +1,201 @@
+//! Tessellation of a strand into a closed triangle tube: rings of `sides` vertices at
+//! `segments` steps along each Bézier segment, oriented by rotation-minimising frames so
+//! the tube neither twists nor flips (a Frenet frame flips at every inflection point),
+//! closed by hemispheres like the round ends of direct intersection.
+
+use raylab_core::{Frame, Vec3};
+
+use super::Bezier;
+use crate::material::MaterialId;
+use crate::shape::TriangleMesh;
+
+/// Unit normals `r_i ⊥ t_i` transported along the polyline `points` with unit tangents
+/// `tangents` by the double-reflection method (Wang, Jüttler, Zheng & Liu 2008,
+/// "Computation of rotation minimizing frames"): reflect the frame in the bisector plane
+/// of the chord, then in the plane that maps the reflected tangent onto the next one.
+pub fn rotation_minimising_normals(points: &[Vec3], tangents: &[Vec3]) -> Vec<Vec3> {
+    let Some(&t0) = tangents.first() else { return Vec::new() };
+    let mut normals = vec![Frame::from_z(t0).x];
+    for i in 0..points.len() - 1 {
+        let (r, t) = (normals[i], tangents[i]);
+        let v1 = points[i + 1] - points[i];
+        let c1 = v1.length_squared();
+        let (r_l, t_l) = if c1 > 0.0 { (r - (2.0 / c1) * v1.dot(r) * v1, t - (2.0 / c1) * v1.dot(t) * v1) } else { (r, t) };
+        let v2 = tangents[i + 1] - t_l;
+        let c2 = v2.length_squared();
+        let next = if c2 > 0.0 { r_l - (2.0 / c2) * v2.dot(r_l) * v2 } else { r_l };
+        // Renormalise against drift over thousands of rings.
+        let next = (next - tangents[i + 1] * tangents[i + 1].dot(next)).try_normalize().unwrap_or(next);
+        normals.push(next);
+    }
+    normals
+}
+
+/// A closed tube around the strand `segments` (Bézier segments joined end to end):
+/// `steps` rings per segment, `sides` vertices per ring, and a hemisphere at each end
+/// (rings at `sides / 4` latitudes and a pole), the round ends of direct intersection.
+/// Every vertex is shared, so every edge belongs to exactly two triangles (watertight).
+/// Vertex normals are the exact normals of the round tube. Triangles are ordered so that
+/// `p1 - p0` runs along the strand: without UVs a mesh's `dpdu` is `p1 - p0`, which gives
+/// the hair material its fibre direction.
+pub fn tessellate(segments: &[Bezier], steps: u32, sides: u32, material: MaterialId) -> TriangleMesh {
+    let (steps, sides) = (steps.max(1), sides.max(3));
+    let mut samples = Vec::new();
+    for (k, seg) in segments.iter().enumerate() {
+        let first = if k == 0 { 0 } else { 1 };
+        for j in first..=steps {
+            let u = j as f32 / steps as f32;
+            samples.push((seg.eval(u), seg.derivative(u).truncate()));
+        }
+    }
+    let points: Vec<Vec3> = samples.iter().map(|(p, _)| p.truncate()).collect();
+    let n = points.len();
+    // A zero derivative (coincident control points at an end) falls back to the chord.
+    let tangents: Vec<Vec3> = (0..n)
+        .map(|i| {
+            let chord = points[(i + 1).min(n - 1)] - points[i.saturating_sub(1)];
+            samples[i].1.try_normalize().or(chord.try_normalize()).unwrap_or(Vec3::X)
+        })
+        .collect();
+    let normals = rotation_minimising_normals(&points, &tangents);
+
+    let mut mesh = TriangleMesh { name: "curve".into(), material, ..Default::default() };
+    // A ring around `centre` in the plane of the frame of sample `i`, its normals tilted
+    // by `latitude` towards `t` (an end's outward tangent).
+    let add_ring = |mesh: &mut TriangleMesh, i: usize, centre: Vec3, radius: f32, t: Vec3, latitude: f32| {
+        let first = mesh.positions.len() as u32;
+        let (r, s) = (normals[i], tangents[i].cross(normals[i]));
+        for k in 0..sides {
+            let phi = 2.0 * std::f32::consts::PI * k as f32 / sides as f32;
+            let radial = phi.cos() * r + phi.sin() * s;
+            mesh.positions.push(centre + radius * radial);
+            mesh.normals.push(latitude.cos() * radial + latitude.sin() * t);
+        }
+        first
+    };
+    let side_rings: Vec<u32> = (0..n).map(|i| add_ring(&mut mesh, i, points[i], samples[i].0.w, tangents[i], 0.0)).collect();
+    let latitudes = (sides / 4).max(1);
+    let cap = |mesh: &mut TriangleMesh, i: usize, dir: f32| -> (Vec<u32>, u32) {
+        let (centre, radius, t) = (points[i], samples[i].0.w, dir * tangents[i]);
+        let rings = (1..latitudes).map(|j| {
+            let a = std::f32::consts::FRAC_PI_2 * j as f32 / latitudes as f32;
+            add_ring(mesh, i, centre + radius * a.sin() * t, radius * a.cos(), t, a)
+        }).collect();
+        mesh.positions.push(centre + radius * t);
+        mesh.normals.push(t);
+        (rings, mesh.positions.len() as u32 - 1)
+    };
+    let (start_rings, start_pole) = cap(&mut mesh, 0, -1.0);
+    let (end_rings, end_pole) = cap(&mut mesh, n - 1, 1.0);
+    // Every ring from the start pole to the end pole, in order along the strand.
+    let rings: Vec<u32> = start_rings.iter().rev().chain(&side_rings).chain(&end_rings).copied().collect();
+    let at = |ring: u32, k: u32| ring + k % sides;
+    for pair in rings.windows(2) {
+        for k in 0..sides {
+            let (a, b, c, d) = (at(pair[0], k), at(pair[1], k), at(pair[1], k + 1), at(pair[0], k + 1));
+            // Outward winding, with the first edge along the strand (see above).
+            mesh.indices.push([b, a, c]);
+            mesh.indices.push([d, c, a]);
+        }
+    }
+    let (first, last) = (rings[0], rings[rings.len() - 1]);
+    for k in 0..sides {
+        mesh.indices.push([start_pole, at(first, k + 1), at(first, k)]);
+        mesh.indices.push([end_pole, at(last, k), at(last, k + 1)]);
+    }
+    mesh
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::HashMap;
+
+    use glam::Vec4;
+
+    use super::*;
+    use crate::shape::curve::{to_bezier_segments, Basis};
+
+    /// A planar S: two cubic arcs bending opposite ways, an inflection where they meet.
+    fn s_curve() -> Vec<Bezier> {
+        let p = [(0.0, 0.0), (0.0, 1.0), (1.0, 1.0), (1.0, 0.0), (1.0, -1.0), (2.0, -1.0), (2.0, 0.0)];
+        to_bezier_segments(Basis::Bezier, 3, &p.map(|(x, y)| Vec4::new(x, y, 0.0, 0.1))).unwrap()
+    }
+
+    #[test]
+    fn tubes_are_closed() {
+        for (steps, sides) in [(2, 3), (4, 4), (8, 16)] {
+            let mesh = tessellate(&s_curve(), steps, sides, MaterialId::default());
+            // Side rings, then `sides / 4 - 1` more rings and a pole on each hemisphere.
+            let rings = 2 * steps + 1 + 2 * ((sides / 4).max(1) - 1);
+            assert_eq!(mesh.len() as u32, 2 * sides * (rings - 1) + 2 * sides);
+            let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
+            for t in &mesh.indices {
+                for e in 0..3 {
+                    let (a, b) = (t[e], t[(e + 1) % 3]);
+                    *edges.entry((a.min(b), a.max(b))).or_default() += 1;
+                }
+            }
+            assert!(edges.values().all(|&c| c == 2), "steps {steps} sides {sides}: an edge is not shared by exactly two triangles");
+            // Every directed edge appears once: the windings agree (an oriented surface).
+            let mut directed = std::collections::HashSet::new();
+            for t in &mesh.indices {
+                for e in 0..3 {
+                    assert!(directed.insert((t[e], t[(e + 1) % 3])), "inconsistent winding");
+                }
+            }
+            // The winding faces outwards: positive signed volume (divergence theorem),
+            // close to Pappus' π r² L plus a ball for the two ends once the tube is fine.
+            let volume: f32 = (0..mesh.len() as u32).map(|t| {
+                let [a, b, c] = mesh.vertices(t);
+                a.dot(b.cross(c)) / 6.0
+            }).sum();
+            assert!(volume > 0.0, "steps {steps} sides {sides}: the tube is inside out ({volume})");
+            if sides == 16 {
+                let length: f32 = s_curve().iter().map(|s| (0..1000).map(|j| (s.point((j + 1) as f32 / 1000.0) - s.point(j as f32 / 1000.0)).length()).sum::<f32>()).sum();
+                let pappus = std::f32::consts::PI * (0.01 * length + 4.0 / 3.0 * 0.001);
+                assert!((volume / pappus - 1.0).abs() < 0.05, "volume {volume} vs π r² L + 4/3 π r³ = {pappus}");
+            }
+        }
+    }
+
+    #[test]
+    fn frames_are_continuous_through_an_inflection() {
+        let segs = s_curve();
+        let mut points = Vec::new();
+        let mut tangents = Vec::new();
+        for seg in &segs {
+            for j in 0..64 {
+                let u = j as f32 / 64.0;
+                points.push(seg.point(u));
+                tangents.push(seg.derivative(u).truncate().normalize());
+            }
+        }
+        let normals = rotation_minimising_normals(&points, &tangents);
+        for i in 0..normals.len() {
+            assert!((normals[i].length() - 1.0).abs() < 1e-4 && normals[i].dot(tangents[i]).abs() < 1e-4, "ring {i}");
+            if i > 0 {
+                // Adjacent frames turn by no more than the tangent does (a few degrees).
+                let turn = normals[i].angle_between(normals[i - 1]);
+                assert!(turn <= tangents[i].angle_between(tangents[i - 1]) + 1e-3, "ring {i}: frame turned {turn} rad");
+            }
+            // In a plane, the rotation-minimising frame keeps its angles to the plane's
+            // normal and to the in-plane side `z × t`: no flip at the inflection, where a
+            // Frenet normal reverses.
+            let side = |i: usize| normals[i].dot(Vec3::Z.cross(tangents[i]));
+            assert!((normals[i].z - normals[0].z).abs() < 1e-3 && (side(i) - side(0)).abs() < 1e-3, "ring {i}: {} vs {}", normals[i], normals[0]);
+        }
+    }
+
+    #[test]
+    fn rings_lie_on_the_tube() {
+        let segs = s_curve();
+        let mesh = tessellate(&segs, 4, 8, MaterialId::default());
+        // Ring 3 is at u = 3/4 of the first segment; its vertices are one radius from it.
+        let c = segs[0].point(0.75);
+        let t = segs[0].derivative(0.75).truncate().normalize();
+        for k in 0..8 {
+            let offset = mesh.positions[3 * 8 + k] - c;
+            assert!((offset.length() - 0.1).abs() < 1e-5 && offset.dot(t).abs() < 1e-5, "{offset}");
+        }
+    }
+}
