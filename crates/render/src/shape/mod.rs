@@ -1,11 +1,13 @@
 //! Shapes and the scene's geometry: the list of primitives that acceleration structures
 //! index into.
 
+pub mod bezier_patch;
 mod mesh;
 mod sphere;
 
 use std::ops::Range;
 
+pub use bezier_patch::BezierPatch;
 pub use mesh::TriangleMesh;
 pub use sphere::Sphere;
 
