@@ -9,6 +9,7 @@ use raylab_render::bsdf::{Distribution, Geometry as MicrofacetGeometry};
 use raylab_render::filter::PixelFilter;
 use raylab_render::light::LightSampling;
 use raylab_render::material::TexColor;
+use raylab_render::shape::bezier_patch::DEFAULT_SUBDIVISIONS;
 use raylab_render::shape::Sphere;
 use raylab_render::texture::{Checker, CheckerSpace, Filter, ImageTexture, Noise, NoiseKind, Wrap};
 use raylab_render::{Background, Camera, IntegratorKind, Light, Material, MaterialId, RenderSettings, SamplerKind, Scene, Texture, TriangleMesh};
@@ -16,6 +17,7 @@ use raylab_render::{Background, Camera, IntegratorKind, Light, Material, Materia
 use crate::error::LoadError;
 use crate::files::{not_found_message, Found, Resolver};
 use crate::obj::{load_obj, mtl_color, MtlMaterial};
+use crate::patches::load_patch_mesh;
 use crate::toml_read::{Doc, Table, Val};
 
 /// Values from the command line that replace the scene's before anything is built.
@@ -57,7 +59,7 @@ const TEXTURE: &[&str] = &["name", "type", "file", "wrap", "filter", "srgb", "sc
 const MATERIAL: &[&str] = &[
     "name", "type", "albedo", "ka", "kd", "ks", "exponent", "reflectance", "ior", "diffuse", "specular", "roughness", "distribution", "geometry", "f0",
 ];
-const SHAPE: &[&str] = &["type", "material", "transform", "center", "radius", "vertices", "normals", "uvs", "file", "smooth"];
+const SHAPE: &[&str] = &["type", "material", "transform", "center", "radius", "vertices", "normals", "uvs", "file", "smooth", "crease_angle", "subdivisions"];
 const LIGHT: &[&str] = &["type", "position", "intensity", "direction", "irradiance", "vertices", "radiance", "texture", "center", "radius", "n"];
 const TRANSFORM_STEP: &[&str] = &["scale", "rotate", "translate"];
 const ROTATE: &[&str] = &["axis", "degrees"];
@@ -399,12 +401,13 @@ impl Builder<'_> {
     }
 
     fn shape(&mut self, scene: &mut Scene, t: &Table) -> Result<(), LoadError> {
-        let kind = t.type_name(&["sphere", "triangle", "quad", "mesh"])?;
+        let kind = t.type_name(&["sphere", "triangle", "quad", "mesh", "bezier_patch"])?;
         let valid: &[&str] = match kind {
             "sphere" => &["center", "radius"],
             "triangle" => &["vertices", "normals", "uvs"],
             "quad" => &["vertices", "uvs"],
-            _ => &["file", "smooth"],
+            "bezier_patch" => &["file", "subdivisions"],
+            _ => &["file", "smooth", "crease_angle"],
         };
         for k in SHAPE {
             if !["type", "material", "transform"].contains(k) && !valid.contains(k) && t.has(k) {
@@ -449,6 +452,12 @@ impl Builder<'_> {
                     None => {}
                 }
                 scene.geometry.add_mesh(mesh);
+            }
+            "bezier_patch" => {
+                let found = self.find(&t.req("file")?)?;
+                let subdivisions = t.opt("subdivisions", |v| in_range(v, v.integer()?, 1, 256))?.map_or(DEFAULT_SUBDIVISIONS, |n| n as u32);
+                let mesh = load_patch_mesh(&found, subdivisions, &to_world)?;
+                scene.geometry.add_mesh(TriangleMesh { material: mat, ..mesh });
             }
             _ => {
                 let fv = t.req("file")?;
