@@ -463,6 +463,7 @@ impl Builder<'_> {
                 let fv = t.req("file")?;
                 let found = self.find(&fv)?;
                 let smooth = t.opt("smooth", |v| v.bool())?.unwrap_or(false);
+                let crease = t.opt("crease_angle", |v| if smooth { in_range_f32(v, v.f32()?, 0.0, 180.0) } else { Err(v.err("needs `smooth = true`")) })?.unwrap_or(180.0);
                 let obj = load_obj(&found, &to_world)?;
                 for (mut mesh, mtl) in obj.meshes {
                     if let Some(ke) = mtl.and_then(|k| obj.materials.get(k)).and_then(|m| m.emissive) {
@@ -474,7 +475,7 @@ impl Builder<'_> {
                         _ => MaterialId::default(),
                     };
                     if smooth && mesh.normals.is_empty() {
-                        mesh.compute_smooth_normals();
+                        mesh.compute_smooth_normals(crease);
                     }
                     scene.geometry.add_mesh(mesh);
                 }
