@@ -51,14 +51,23 @@ impl BezierPatch {
     }
 
     pub fn point(&self, u: f32, v: f32) -> Vec3 {
-        let (u, v) = (u as f64, v as f64);
-        self.combine(bernstein(u), bernstein(v)).as_vec3()
+        self.point_f64(u as f64, v as f64).as_vec3()
+    }
+
+    pub(crate) fn point_f64(&self, u: f64, v: f64) -> DVec3 {
+        self.combine(bernstein(u), bernstein(v))
     }
 
     /// `(∂P/∂u, ∂P/∂v)`.
     pub fn derivatives(&self, u: f32, v: f32) -> (Vec3, Vec3) {
         let (du, dv, _) = self.derivatives_f64(u as f64, v as f64);
         (du.as_vec3(), dv.as_vec3())
+    }
+
+    /// `(P, ∂P/∂u, ∂P/∂v)` in double precision, for Newton's method.
+    pub(crate) fn point_and_derivatives_f64(&self, u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
+        let (bu, bv) = (bernstein(u), bernstein(v));
+        (self.combine(bu, bv), self.combine(bernstein_derivative(u), bv), self.combine(bu, bernstein_derivative(v)))
     }
 
     /// `(∂P/∂u, ∂P/∂v, ∂²P/∂u∂v)`.
@@ -93,7 +102,7 @@ impl BezierPatch {
     }
 
     /// The largest extent of the control net, the scale for "vanishing" derivatives.
-    fn size(&self) -> f64 {
+    pub(crate) fn size(&self) -> f64 {
         let (lo, hi) = self.points.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
         (hi - lo).max_element() as f64
     }

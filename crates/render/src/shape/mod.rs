@@ -3,12 +3,14 @@
 
 pub mod bezier_patch;
 mod mesh;
+mod patch_surface;
 mod sphere;
 
 use std::ops::Range;
 
 pub use bezier_patch::BezierPatch;
 pub use mesh::TriangleMesh;
+pub use patch_surface::PatchSurfaces;
 pub use sphere::Sphere;
 
 use raylab_accel::{PrimHit, Primitives};
