@@ -1,12 +1,13 @@
 //! The only crate that reads (and writes) files: scene files (TOML), meshes (OBJ/MTL,
-//! gzipped or not), textures and output images. Every error names the file, the line and
-//! the field.
+//! gzipped or not), Bézier patches, textures and output images. Every error names the
+//! file, the line and the field.
 
 mod curves;
 pub mod error;
 pub mod files;
 pub mod image_io;
 pub mod obj;
+pub mod patches;
 pub mod scene;
 mod toml_read;
 

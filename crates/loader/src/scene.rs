@@ -11,6 +11,7 @@ use raylab_render::integrator::MisHeuristic;
 use raylab_render::light::{EnvironmentLight, LightSampling, MAX_CELLS};
 use raylab_render::material::{TexColor, METALS};
 use raylab_render::shading::{NormalSpace, ShadingPerturbation};
+use raylab_render::shape::bezier_patch::DEFAULT_SUBDIVISIONS;
 use raylab_render::shape::Sphere;
 use raylab_render::texture::{Checker, CheckerSpace, Filter, ImageTexture, Noise, NoiseKind, Wrap};
 use raylab_render::{Background, Camera, IntegratorKind, Light, Material, MaterialId, RenderSettings, SamplerKind, Scene, Texture, TriangleMesh};
@@ -18,6 +19,7 @@ use raylab_render::{Background, Camera, IntegratorKind, Light, Material, Materia
 use crate::error::LoadError;
 use crate::files::{not_found_message, Found, Resolver};
 use crate::obj::{load_obj, mtl_color, MtlMaterial};
+use crate::patches::load_patch_mesh;
 use crate::toml_read::{Doc, Table, Val};
 
 /// Values from the command line that replace the scene's before anything is built.
@@ -66,7 +68,7 @@ const MATERIAL: &[&str] = &[
 ];
 /// Fields every material kind has.
 const MATERIAL_COMMON: &[&str] = &["name", "type", "normal_map", "normal_space", "bump_map", "bump_scale"];
-const SHAPE: &[&str] = &["type", "material", "transform", "center", "radius", "vertices", "normals", "uvs", "file", "smooth", "points", "basis", "degree", "mode", "segments", "sides"];
+const SHAPE: &[&str] = &["type", "material", "transform", "center", "radius", "vertices", "normals", "uvs", "file", "smooth", "points", "basis", "degree", "mode", "segments", "sides", "crease_angle", "subdivisions"];
 const LIGHT: &[&str] = &["type", "position", "intensity", "direction", "irradiance", "vertices", "radiance", "texture", "center", "radius", "n", "file", "scale"];
 const TRANSFORM_STEP: &[&str] = &["scale", "rotate", "translate"];
 const ROTATE: &[&str] = &["axis", "degrees"];
@@ -505,13 +507,14 @@ impl Builder<'_> {
     }
 
     fn shape(&mut self, scene: &mut Scene, t: &Table) -> Result<(), LoadError> {
-        let kind = t.type_name(&["sphere", "triangle", "quad", "mesh", "curve"])?;
+        let kind = t.type_name(&["sphere", "triangle", "quad", "mesh", "curve", "bezier_patch"])?;
         let valid: &[&str] = match kind {
             "sphere" => &["center", "radius"],
             "triangle" => &["vertices", "normals", "uvs"],
             "quad" => &["vertices", "uvs"],
             "curve" => crate::curves::KEYS,
-            _ => &["file", "smooth"],
+            "bezier_patch" => &["file", "subdivisions"],
+            _ => &["file", "smooth", "crease_angle"],
         };
         for k in SHAPE {
             if !["type", "material", "transform"].contains(k) && !valid.contains(k) && t.has(k) {
@@ -561,10 +564,17 @@ impl Builder<'_> {
                 let file = t.get("file").map(|fv| self.find(&fv).map(|found| (fv, found))).transpose()?;
                 crate::curves::add_curves(scene, t, file, mat, &to_world)?;
             }
+            "bezier_patch" => {
+                let found = self.find(&t.req("file")?)?;
+                let subdivisions = t.opt("subdivisions", |v| in_range(v, v.integer()?, 1, 256))?.map_or(DEFAULT_SUBDIVISIONS, |n| n as u32);
+                let mesh = load_patch_mesh(&found, subdivisions, &to_world)?;
+                scene.geometry.add_mesh(TriangleMesh { material: mat, ..mesh });
+            }
             _ => {
                 let fv = t.req("file")?;
                 let found = self.find(&fv)?;
                 let smooth = t.opt("smooth", |v| v.bool())?.unwrap_or(false);
+                let crease = t.opt("crease_angle", |v| if smooth { in_range_f32(v, v.f32()?, 0.0, 180.0) } else { Err(v.err("needs `smooth = true`")) })?.unwrap_or(180.0);
                 let obj = load_obj(&found, &to_world)?;
                 for (mut mesh, mtl) in obj.meshes {
                     if let Some(ke) = mtl.and_then(|k| obj.materials.get(k)).and_then(|m| m.emissive) {
@@ -576,7 +586,7 @@ impl Builder<'_> {
                         _ => MaterialId::default(),
                     };
                     if smooth && mesh.normals.is_empty() {
-                        mesh.compute_smooth_normals();
+                        mesh.compute_smooth_normals(crease);
                     }
                     mesh.object_to_world = to_world;
                     scene.geometry.add_mesh(mesh);

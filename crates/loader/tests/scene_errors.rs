@@ -36,7 +36,7 @@ fn unknown_keys_and_types_list_the_valid_ones() {
     );
     assert_eq!(
         error_of(&format!("{CAMERA}[[shapes]]\ntype = \"cylinder\"\n")),
-        "bad.toml:6: shapes[0].type: unknown type `cylinder` (valid: sphere, triangle, quad, mesh, curve)"
+        "bad.toml:6: shapes[0].type: unknown type `cylinder` (valid: sphere, triangle, quad, mesh, curve, bezier_patch)"
     );
     assert_eq!(
         error_of(&format!("{CAMERA}[[shapes]]\ntype = \"sphere\"\nradius = 1\nvertices = [[0, 0, 0]]\n")),

@@ -85,7 +85,7 @@ fn smooth_mesh(path: &Path) -> Result<TriangleMesh> {
         bail!("{}: the mesh has no triangles", path.display());
     }
     if !with_normals {
-        all.compute_smooth_normals();
+        all.compute_smooth_normals(180.0);
     }
     Ok(all)
 }

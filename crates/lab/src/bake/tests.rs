@@ -25,7 +25,7 @@ fn smooth_sphere(rings: u32, segments: u32) -> TriangleMesh {
             mesh.indices.extend([[a, d, b], [a, c, d]]);
         }
     }
-    mesh.compute_smooth_normals();
+    mesh.compute_smooth_normals(180.0);
     mesh
 }
 
@@ -106,7 +106,7 @@ fn a_baked_tilt_decodes_to_the_high_normal_in_the_renderer() {
             indices: vec![[0, 1, 2], [0, 2, 3]],
             ..Default::default()
         };
-        m.compute_smooth_normals();
+        m.compute_smooth_normals(180.0);
         m
     };
     let low = low_with_atlas(&square(|_| 0.0, 0.0, 1.0), 64);

@@ -106,24 +106,63 @@ impl TriangleMesh {
     /// Angle-weighted vertex normals (Thürmer & Wüthrich 1998) for `smooth = true` on meshes
     /// without normals. Vertices at the same position are welded first, so meshes split
     /// along UV seams (the teapot's patches) shade without a visible crease.
-    pub fn compute_smooth_normals(&mut self) {
+    ///
+    /// Each face corner averages only the faces around its vertex whose normals are within
+    /// `crease_degrees` of its own face's (three.js's `toCreasedNormals`, Blender's auto
+    /// smooth), so edges sharper than that stay sharp; 180 averages every face. A vertex
+    /// whose corners end up with different normals is split, one copy per normal.
+    pub fn compute_smooth_normals(&mut self, crease_degrees: f32) {
         let mut group_of = std::collections::HashMap::new();
         let groups: Vec<usize> = self.positions.iter().map(|p| {
             let next = group_of.len();
             *group_of.entry(p.to_array().map(|c| (c + 0.0).to_bits())).or_insert(next)
         }).collect();
-        let mut n = vec![Vec3::ZERO; group_of.len()];
-        for &tri in &self.indices {
+        // Unit face normals (none for zero-area faces), and per welded vertex the faces
+        // around it with their normals weighted by the corner's angle.
+        let mut faces = Vec::with_capacity(self.indices.len());
+        let mut around = vec![Vec::new(); group_of.len()];
+        for (f, &tri) in self.indices.iter().enumerate() {
             let p = tri.map(|i| self.positions[i as usize]);
-            let Some(face) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else { continue };
+            let face = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize();
+            faces.push(face);
+            let Some(face) = face else { continue };
             for k in 0..3 {
                 let angle = (p[(k + 1) % 3] - p[k]).angle_between(p[(k + 2) % 3] - p[k]);
                 if angle.is_finite() {
-                    n[groups[tri[k] as usize]] += angle * face;
+                    around[groups[tri[k] as usize]].push((f, angle * face));
                 }
             }
         }
-        self.normals = groups.iter().map(|&g| n[g].try_normalize().unwrap_or(Vec3::Y)).collect();
+        // A little slack, so that coplanar faces join even at 0° and all do at 180°.
+        let min_cos = crease_degrees.to_radians().cos() - 1e-6;
+        let normal_of = |group: usize, own: Option<Vec3>| -> Vec3 {
+            let joined = around[group].iter().filter(|(f, _)| own.is_none_or(|n| faces[*f].is_some_and(|m| m.dot(n) >= min_cos)));
+            joined.map(|(_, weighted)| *weighted).sum::<Vec3>().try_normalize().unwrap_or(Vec3::Y)
+        };
+        let mut normals: Vec<Option<Vec3>> = vec![None; self.positions.len()];
+        let mut copies = std::collections::HashMap::new();
+        for f in 0..self.indices.len() {
+            for k in 0..3 {
+                let v = self.indices[f][k] as usize;
+                let n = normal_of(groups[v], faces[f]);
+                match normals[v] {
+                    None => normals[v] = Some(n),
+                    Some(m) if m == n => {}
+                    Some(_) => {
+                        self.indices[f][k] = *copies.entry((v, n.to_array().map(f32::to_bits))).or_insert_with(|| {
+                            self.positions.push(self.positions[v]);
+                            if !self.uvs.is_empty() {
+                                self.uvs.push(self.uvs[v]);
+                            }
+                            normals.push(Some(n));
+                            normals.len() as u32 - 1
+                        });
+                    }
+                }
+            }
+        }
+        // Vertices no face uses take the average of everything at their position.
+        self.normals = normals.iter().enumerate().map(|(v, n)| n.unwrap_or_else(|| normal_of(groups[v], None))).collect();
     }
 
     /// Per-vertex tangents for tangent-space normal maps (needs `uvs`). Each triangle's unit
@@ -198,7 +237,7 @@ mod tests {
             indices: vec![[0, 2, 1], [3, 5, 4]],
             ..Default::default()
         };
-        mesh.compute_smooth_normals();
+        mesh.compute_smooth_normals(180.0);
         // Both copies of each ridge vertex get the average of the two faces: straight up.
         for i in [0, 1, 3, 5] {
             assert!((mesh.normals[i] - Vec3::Y).length() < 1e-6, "{i}: {}", mesh.normals[i]);
@@ -206,5 +245,61 @@ mod tests {
         // The eaves belong to one face each.
         let left = Vec3::new(-1.0, 1.0, 0.0).normalize();
         assert!((mesh.normals[2] - left).length() < 1e-6, "{}", mesh.normals[2]);
+    }
+
+    #[test]
+    fn roof_ridge_is_creased_only_beyond_the_crease_angle() {
+        // The roof's faces are 90° apart.
+        let roof = || TriangleMesh {
+            positions: vec![Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 1.0), Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0)],
+            indices: vec![[0, 2, 1], [0, 1, 3]],
+            ..Default::default()
+        };
+        let mut smooth = roof();
+        smooth.compute_smooth_normals(91.0);
+        assert_eq!(smooth.positions.len(), 4);
+        assert!((smooth.normals[0] - Vec3::Y).length() < 1e-6);
+        let mut creased = roof();
+        creased.compute_smooth_normals(89.0);
+        // Each ridge vertex is split in two, one copy per face.
+        assert_eq!(creased.positions.len(), 6);
+        for tri in 0..2 {
+            let face = creased.winding_normal(tri);
+            for k in creased.indices[tri as usize] {
+                assert!((creased.normals[k as usize] - face).length() < 1e-6, "{tri}: {}", creased.normals[k as usize]);
+            }
+        }
+    }
+
+    /// A closed cube over 8 shared vertices, its triangles wound outwards.
+    fn cube() -> TriangleMesh {
+        let positions = (0..8).map(|i| Vec3::new((i & 1) as f32, (i >> 1 & 1) as f32, (i >> 2 & 1) as f32) * 2.0 - Vec3::ONE).collect();
+        let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        let indices = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
+        TriangleMesh { positions, indices, ..Default::default() }
+    }
+
+    #[test]
+    fn cube_keeps_flat_faces_under_a_crease_angle_and_averages_corners_without() {
+        let mut flat = cube();
+        for tri in 0..flat.len() as u32 {
+            let [a, b, c] = flat.vertices(tri);
+            assert!(flat.winding_normal(tri).dot(a + b + c) > 0.0, "triangle {tri} winds inwards");
+        }
+        flat.compute_smooth_normals(30.0);
+        assert_eq!(flat.positions.len(), 24, "each corner split into one vertex per face");
+        for tri in 0..flat.len() as u32 {
+            let face = flat.winding_normal(tri);
+            for k in flat.indices[tri as usize] {
+                assert!((flat.normals[k as usize] - face).length() < 1e-6, "{tri}: {}", flat.normals[k as usize]);
+            }
+        }
+        let mut round = cube();
+        round.compute_smooth_normals(180.0);
+        assert_eq!(round.positions.len(), 8);
+        for (p, n) in round.positions.iter().zip(&round.normals) {
+            // Each face meets the corner at 90° in all: the diagonal.
+            assert!((*n - p.normalize()).length() < 1e-6, "{p}: {n}");
+        }
     }
 }

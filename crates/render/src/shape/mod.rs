@@ -1,14 +1,18 @@
 //! Shapes and the scene's geometry: the list of primitives that acceleration structures
 //! index into.
 
+pub mod bezier_patch;
 pub mod curve;
 mod mesh;
+mod patch_surface;
 mod sphere;
 
 use std::ops::Range;
 
+pub use bezier_patch::BezierPatch;
 pub use curve::Curve;
 pub use mesh::TriangleMesh;
+pub use patch_surface::PatchSurfaces;
 pub use sphere::Sphere;
 
 use raylab_accel::{PrimHit, Primitives};

@@ -1,0 +1,165 @@
+//! Direct ray–patch intersection, the alternative to tracing a fine tessellation: Newton's
+//! method on `P(u, v) − (o + t·d) = 0`, seeded where the ray meets a coarse tessellation
+//! of the patch. Each patch is one primitive, bounded by its control points (a Bézier
+//! patch lies in their convex hull), so every acceleration structure can index them.
+
+use glam::DVec3;
+use raylab_accel::{PrimHit, Primitives};
+use raylab_core::{Aabb, Ray};
+
+use super::BezierPatch;
+
+/// Seed-grid triangles the ray misses by up to this much (in barycentrics) still seed a
+/// solve: the coarse grid's chords cut inside convex parts of the surface, so rays near a
+/// silhouette can hit the surface and miss the chords.
+const SEED_SLACK: f64 = 0.5;
+const NEWTON_STEPS: usize = 10;
+
+/// Bicubic patches as primitives, intersected exactly (to `f64` Newton tolerance).
+#[derive(Clone, Debug)]
+pub struct PatchSurfaces {
+    patches: Vec<BezierPatch>,
+    seed_grid: usize,
+    /// `(seed_grid + 1)²` points per patch, row by row in `v`.
+    seeds: Vec<DVec3>,
+}
+
+impl PatchSurfaces {
+    /// `seed_grid` quads per patch side seed the solves.
+    pub fn new(patches: Vec<BezierPatch>, seed_grid: u32) -> Self {
+        assert!(seed_grid > 0, "the seed grid needs at least one quad");
+        let n = seed_grid as usize;
+        let param = |k: usize| k as f64 / n as f64;
+        let seeds = patches.iter().flat_map(|p| (0..=n).flat_map(move |i| (0..=n).map(move |j| p.point_f64(param(j), param(i))))).collect();
+        Self { patches, seed_grid: n, seeds }
+    }
+
+    pub fn patch(&self, i: u32) -> &BezierPatch {
+        &self.patches[i as usize]
+    }
+
+    /// The closest hit `(t, u, v)` of the ray with patch `i`, `t` in `(t_min, t_max]`.
+    pub fn intersect_patch(&self, i: u32, ray: &Ray) -> Option<(f32, f32, f32)> {
+        let patch = &self.patches[i as usize];
+        let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
+        let n = self.seed_grid;
+        let side = n + 1;
+        let grid = &self.seeds[i as usize * side * side..][..side * side];
+        let tolerance = 1e-9 * patch.size();
+        let mut best: Option<(f32, f32, f32)> = None;
+        for row in 0..n {
+            for col in 0..n {
+                let corner = |di: usize, dj: usize| (grid[(row + di) * side + col + dj], DVec3::new((col + dj) as f64, (row + di) as f64, 0.0) / n as f64);
+                for [a, b, c] in [[corner(0, 0), corner(0, 1), corner(1, 1)], [corner(0, 0), corner(1, 1), corner(1, 0)]] {
+                    let Some((t, b1, b2)) = plane_hit(o, d, [a.0, b.0, c.0]) else { continue };
+                    let uv = (1.0 - b1 - b2) * a.1 + b1 * b.1 + b2 * c.1;
+                    let Some((u, v, t)) = newton(patch, o, d, (uv.x.clamp(0.0, 1.0), uv.y.clamp(0.0, 1.0), t), tolerance) else { continue };
+                    let t = t as f32;
+                    if t > ray.t_min && t <= ray.t_max && best.is_none_or(|h| t < h.0) {
+                        best = Some((t, u as f32, v as f32));
+                    }
+                }
+            }
+        }
+        best
+    }
+}
+
+/// Where the ray meets the plane of `[a, b, c]`: `(t, b1, b2)`, if the barycentrics are
+/// all at least `-SEED_SLACK`.
+fn plane_hit(o: DVec3, d: DVec3, [a, b, c]: [DVec3; 3]) -> Option<(f64, f64, f64)> {
+    let (e1, e2) = (b - a, c - a);
+    let p = d.cross(e2);
+    let det = e1.dot(p);
+    if det == 0.0 {
+        return None;
+    }
+    let s = o - a;
+    let q = s.cross(e1);
+    let (b1, b2) = (s.dot(p) / det, d.dot(q) / det);
+    (b1 >= -SEED_SLACK && b2 >= -SEED_SLACK && 1.0 - b1 - b2 >= -SEED_SLACK).then(|| (e2.dot(q) / det, b1, b2))
+}
+
+/// Solves `P(u, v) = o + t·d` from `start`; the root if it converges inside the patch.
+fn newton(patch: &BezierPatch, o: DVec3, d: DVec3, start: (f64, f64, f64), tolerance: f64) -> Option<(f64, f64, f64)> {
+    let (mut u, mut v, mut t) = start;
+    for _ in 0..NEWTON_STEPS {
+        let (p, pu, pv) = patch.point_and_derivatives_f64(u, v);
+        let f = p - (o + t * d);
+        if f.length() < tolerance {
+            let inside = |x: f64| (-1e-9..=1.0 + 1e-9).contains(&x);
+            return (inside(u) && inside(v)).then(|| (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0), t));
+        }
+        // The Jacobian's columns are ∂P/∂u, ∂P/∂v and −d; Cramer's rule for the step.
+        let det = pu.dot(pv.cross(-d));
+        if det.abs() <= 1e-12 * pu.length() * pv.length() * d.length() {
+            return None;
+        }
+        u -= f.dot(pv.cross(-d)) / det;
+        v -= pu.dot(f.cross(-d)) / det;
+        t -= pu.dot(pv.cross(f)) / det;
+        // Far outside the patch the bicubic's other roots lie; stop wandering there.
+        if !(-1.0..=2.0).contains(&u) || !(-1.0..=2.0).contains(&v) {
+            return None;
+        }
+    }
+    None
+}
+
+impl Primitives for PatchSurfaces {
+    fn len(&self) -> usize {
+        self.patches.len()
+    }
+
+    fn bounds(&self, i: u32) -> Aabb {
+        Aabb::from_points(self.patches[i as usize].points)
+    }
+
+    fn intersect(&self, i: u32, ray: &Ray) -> Option<PrimHit> {
+        self.intersect_patch(i, ray).map(|(t, u, v)| PrimHit { t, u, v })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use raylab_core::Vec3;
+
+    /// z = (B1 + B2)(u) (B1 + B2)(v) over (2u, 3v): a dome with z(0.5, 0.5) = 0.5625.
+    fn dome() -> BezierPatch {
+        let mut points = [Vec3::ZERO; 16];
+        for row in 0..4 {
+            for col in 0..4 {
+                let inner = (1..3).contains(&row) && (1..3).contains(&col);
+                points[4 * row + col] = Vec3::new(2.0 * col as f32 / 3.0, row as f32, if inner { 1.0 } else { 0.0 });
+            }
+        }
+        BezierPatch { points }
+    }
+
+    #[test]
+    fn ray_down_onto_the_dome_hits_its_height() {
+        let s = PatchSurfaces::new(vec![dome()], 2);
+        let (t, u, v) = s.intersect_patch(0, &Ray::new(Vec3::new(1.0, 1.5, 5.0), -Vec3::Z)).unwrap();
+        assert!((t - (5.0 - 0.5625)).abs() < 1e-6 && (u - 0.5).abs() < 1e-6 && (v - 0.5).abs() < 1e-6, "{t} {u} {v}");
+        // At (u, v) = (0.25, 0.5): z = (36/64)(0.75).
+        let (t, u, _) = s.intersect_patch(0, &Ray::new(Vec3::new(0.5, 1.5, 5.0), -Vec3::Z)).unwrap();
+        assert!((t - (5.0 - 0.421875)).abs() < 1e-6 && (u - 0.25).abs() < 1e-6, "{t} {u}");
+    }
+
+    #[test]
+    fn closest_of_two_hits_and_the_ray_interval() {
+        let s = PatchSurfaces::new(vec![dome()], 2);
+        // Sideways through the dome at x = 1, z = 0.3: in at one flank, out at the other.
+        let ray = Ray::new(Vec3::new(1.0, -1.0, 0.3), Vec3::Y);
+        let (t_in, _, v_in) = s.intersect_patch(0, &ray).unwrap();
+        let p = dome().point(0.5, v_in);
+        assert!((p - ray.at(t_in)).length() < 1e-5 && v_in < 0.5, "{t_in} {v_in}");
+        let (t_out, _, v_out) = s.intersect_patch(0, &Ray { t_min: t_in + 0.1, ..ray }).unwrap();
+        assert!(t_out > t_in + 0.1 && v_out > 0.5, "{t_out} {v_out}");
+        assert!(s.intersect_patch(0, &Ray { t_max: t_in * 0.9, ..ray }).is_none());
+        // Beside the patch, and above it.
+        assert!(s.intersect_patch(0, &Ray::new(Vec3::new(2.5, 1.5, 5.0), -Vec3::Z)).is_none());
+        assert!(s.intersect_patch(0, &Ray::new(Vec3::new(-1.0, 1.5, 0.6), Vec3::X)).is_none());
+    }
+}
