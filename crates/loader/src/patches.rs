@@ -35,6 +35,16 @@ pub fn load_patch_mesh(found: &Found, subdivisions: u32, to_world: &Transform) -
     Ok(mesh)
 }
 
+/// The patches of `found` with their control points in world space (a Bézier patch
+/// transforms with its control points), for direct intersection.
+pub fn load_patches_world(found: &Found, to_world: &Transform) -> Result<Vec<BezierPatch>, LoadError> {
+    let mut patches = load_patches(found)?;
+    for patch in &mut patches {
+        patch.points = patch.points.map(|p| to_world.point(p));
+    }
+    Ok(patches)
+}
+
 /// The patches of a `.txt` (Newell) or `.bpt` (SPD) file, gzipped or not.
 pub fn load_patches(found: &Found) -> Result<Vec<BezierPatch>, LoadError> {
     let path = found.path();

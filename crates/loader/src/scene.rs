@@ -12,6 +12,7 @@ use raylab_render::light::{EnvironmentLight, LightSampling, MAX_CELLS};
 use raylab_render::material::{TexColor, METALS};
 use raylab_render::shading::{NormalSpace, ShadingPerturbation};
 use raylab_render::shape::bezier_patch::DEFAULT_SUBDIVISIONS;
+use raylab_render::shape::{PatchSurfaces, DEFAULT_SEED_GRID};
 use raylab_render::shape::Sphere;
 use raylab_render::texture::{Checker, CheckerSpace, Filter, ImageTexture, Noise, NoiseKind, Wrap};
 use raylab_render::{Background, Camera, IntegratorKind, Light, Material, MaterialId, RenderSettings, SamplerKind, Scene, Texture, TriangleMesh};
@@ -19,7 +20,7 @@ use raylab_render::{Background, Camera, IntegratorKind, Light, Material, Materia
 use crate::error::LoadError;
 use crate::files::{not_found_message, Found, Resolver};
 use crate::obj::{load_obj, mtl_color, MtlMaterial};
-use crate::patches::load_patch_mesh;
+use crate::patches::{load_patch_mesh, load_patches_world};
 use crate::toml_read::{Doc, Table, Val};
 
 /// Values from the command line that replace the scene's before anything is built.
@@ -513,7 +514,7 @@ impl Builder<'_> {
             "triangle" => &["vertices", "normals", "uvs"],
             "quad" => &["vertices", "uvs"],
             "curve" => crate::curves::KEYS,
-            "bezier_patch" => &["file", "subdivisions"],
+            "bezier_patch" => &["file", "mode", "subdivisions"],
             _ => &["file", "smooth", "crease_angle"],
         };
         for k in SHAPE {
@@ -566,9 +567,25 @@ impl Builder<'_> {
             }
             "bezier_patch" => {
                 let found = self.find(&t.req("file")?)?;
-                let subdivisions = t.opt("subdivisions", |v| in_range(v, v.integer()?, 1, 256))?.map_or(DEFAULT_SUBDIVISIONS, |n| n as u32);
-                let mesh = load_patch_mesh(&found, subdivisions, &to_world)?;
-                scene.geometry.add_mesh(TriangleMesh { material: mat, ..mesh });
+                let direct = match t.get("mode") {
+                    None => false,
+                    Some(v) => match v.str()? {
+                        "tessellate" => false,
+                        "direct" => true,
+                        m => return Err(v.err(format!("unknown mode `{m}` (valid: tessellate, direct)"))),
+                    },
+                };
+                if direct {
+                    if let Some(v) = t.get("subdivisions") {
+                        return Err(v.err("only used with mode = \"tessellate\""));
+                    }
+                    let patches = load_patches_world(&found, &to_world)?;
+                    scene.geometry.add_patches(PatchSurfaces::new(patches, DEFAULT_SEED_GRID, mat));
+                } else {
+                    let subdivisions = t.opt("subdivisions", |v| in_range(v, v.integer()?, 1, 256))?.map_or(DEFAULT_SUBDIVISIONS, |n| n as u32);
+                    let mesh = load_patch_mesh(&found, subdivisions, &to_world)?;
+                    scene.geometry.add_mesh(TriangleMesh { material: mat, ..mesh });
+                }
             }
             _ => {
                 let fv = t.req("file")?;

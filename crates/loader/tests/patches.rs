@@ -153,7 +153,9 @@ fn example_scene_stands_the_teapot_up() {
 #[test]
 fn bezier_patch_shape_errors() {
     assert_eq!(scene_error("file = \"teapot.bpt\"\nsubdivisions = 0\n"), "bad.toml:8: shapes[0].subdivisions: must be between 1 and 256, found 0");
-    assert_eq!(scene_error("file = \"teapot.bpt\"\nsmooth = true\n"), "bad.toml:8: shapes[0].smooth: not a field of `bezier_patch` shapes (valid: type, material, transform, file, subdivisions)");
+    assert_eq!(scene_error("file = \"teapot.bpt\"\nsmooth = true\n"), "bad.toml:8: shapes[0].smooth: not a field of `bezier_patch` shapes (valid: type, material, transform, file, mode, subdivisions)");
+    assert_eq!(scene_error("file = \"teapot.bpt\"\nmode = \"exact\"\n"), "bad.toml:8: shapes[0].mode: unknown mode `exact` (valid: tessellate, direct)");
+    assert_eq!(scene_error("file = \"teapot.bpt\"\nmode = \"direct\"\nsubdivisions = 4\n"), "bad.toml:9: shapes[0].subdivisions: only used with mode = \"tessellate\"");
     assert_eq!(scene_error("subdivisions = 4\n"), "bad.toml:5: shapes[0].file: missing (required)");
     let msg = scene_error("file = \"no_such_teapot.bpt\"\n");
     assert!(msg.starts_with("bad.toml:7: shapes[0].file: cannot find `no_such_teapot.bpt` (looked in "), "{msg}");
@@ -166,7 +168,7 @@ fn newton_patches_agree_with_a_fine_tessellation() {
     let patches = teapot("teapot_newell_patches.txt");
     // A 4 × 4 seed grid misses the nearer of two roots on a few grazing rays here
     // (distances off by up to 0.66); 8 × 8 finds them all.
-    let surfaces = PatchSurfaces::new(patches.clone(), 8);
+    let surfaces = PatchSurfaces::new(patches.clone(), 8, Default::default());
     let mut fine = Geometry::default();
     fine.add_mesh(tessellate(&patches, 64));
     let b = fine.total_bounds();
@@ -197,7 +199,7 @@ fn newton_patches_agree_with_a_fine_tessellation() {
 
 #[test]
 fn every_accel_agrees_with_brute_force_on_newton_patches() {
-    let surfaces = PatchSurfaces::new(teapot("teapot.bpt"), 8);
+    let surfaces = PatchSurfaces::new(teapot("teapot.bpt"), 8, Default::default());
     let b = raylab_accel::primitives::total_bounds(&surfaces);
     let rays = kit::random_rays(&mut Pcg32::new(8, 64), 1000, &Aabb::new(b.min - b.extent(), b.max + b.extent()), &b);
     let oracle = AnyAccel::build(AccelKind::None, &surfaces, &BuildOptions::default());
@@ -211,4 +213,26 @@ fn every_accel_agrees_with_brute_force_on_newton_patches() {
             assert_eq!(got.map(|h| h.t), want.map(|h| h.t), "{kind} ray {k}");
         }
     }
+}
+
+/// The direct patches in a scene render like the tessellation they converge to: the image
+/// error against them falls more than tenfold from 4 to 40 subdivisions (what is left at
+/// 40 is silhouette pixels at one sample each).
+#[test]
+fn direct_patches_render_like_fine_tessellations() {
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let o = Overrides { width: Some(80), height: Some(60), spp: Some(1), ..Default::default() };
+    let render = |scene: raylab_render::Scene| raylab_render::render(&scene, &|_| {}).pixels;
+    let direct = load_scene(&root.join("lab/teapot_patches_direct.toml"), &o).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(direct.geometry.patch_sets[0].len(), 32);
+    let direct = render(direct);
+    let src = std::fs::read_to_string(root.join("teapot_patches.toml")).unwrap();
+    let mse = |n: u32| {
+        let text = src.replace("subdivisions = 10", &format!("subdivisions = {n}"));
+        let scene = load_scene_str(&text, &root.join("tessellated.toml"), &Resolver::Disk { base: root.clone() }, &o).unwrap_or_else(|e| panic!("{e}"));
+        let img = render(scene);
+        img.iter().zip(&direct).map(|(a, b)| (*a - *b).length_squared() as f64 / 3.0).sum::<f64>() / img.len() as f64
+    };
+    let (coarse, fine) = (mse(4), mse(40));
+    assert!(fine < 5e-4 && fine * 10.0 < coarse, "MSE against direct: 4 subdivisions {coarse}, 40 subdivisions {fine}");
 }

@@ -247,7 +247,7 @@ impl AreaLights {
                 let n = sampling::uniform_sphere(u);
                 (sphere.to_world.point(sphere.center) + sphere.radius * n, n, Vec2::ZERO)
             }
-            PrimRef::Curve { .. } => unreachable!("curves do not emit light"),
+            PrimRef::Curve { .. } | PrimRef::Patch { .. } => unreachable!("curves and patches do not emit light"),
         };
         towards(p, q, n, le_at(uv, q), choice / area(geometry, prim))
     }
@@ -380,6 +380,6 @@ fn area(geometry: &Geometry, prim: u32) -> f32 {
             let r = geometry.spheres[s as usize].radius;
             4.0 * PI * r * r
         }
-        PrimRef::Curve { .. } => unreachable!("curves do not emit light"),
+        PrimRef::Curve { .. } | PrimRef::Patch { .. } => unreachable!("curves and patches do not emit light"),
     }
 }

@@ -12,7 +12,7 @@ use std::ops::Range;
 pub use bezier_patch::BezierPatch;
 pub use curve::Curve;
 pub use mesh::TriangleMesh;
-pub use patch_surface::PatchSurfaces;
+pub use patch_surface::{PatchSurfaces, DEFAULT_SEED_GRID};
 pub use sphere::Sphere;
 
 use raylab_accel::{PrimHit, Primitives};
@@ -45,6 +45,8 @@ pub enum PrimRef {
     Sphere(u32),
     /// One Bézier segment of a strand.
     Curve { curve: u32, seg: u32 },
+    /// One bicubic patch intersected directly (Newton), of patch set `set`.
+    Patch { set: u32, patch: u32 },
 }
 
 /// All shapes of a scene, flattened into primitives. Each shape's primitives are
@@ -54,6 +56,7 @@ pub struct Geometry {
     pub meshes: Vec<TriangleMesh>,
     pub spheres: Vec<Sphere>,
     pub curves: Vec<Curve>,
+    pub patch_sets: Vec<PatchSurfaces>,
     prims: Vec<PrimRef>,
     objects: Vec<Range<u32>>,
 }
@@ -83,6 +86,15 @@ impl Geometry {
         self.curves.push(curve);
     }
 
+    /// Bicubic patches intersected directly; the set is one object.
+    pub fn add_patches(&mut self, set: PatchSurfaces) {
+        let s = self.patch_sets.len() as u32;
+        let start = self.prims.len() as u32;
+        self.prims.extend((0..set.len() as u32).map(|patch| PrimRef::Patch { set: s, patch }));
+        self.objects.push(start..self.prims.len() as u32);
+        self.patch_sets.push(set);
+    }
+
     pub fn prim(&self, i: u32) -> PrimRef {
         self.prims[i as usize]
     }
@@ -96,6 +108,7 @@ impl Geometry {
             PrimRef::Triangle { mesh, .. } => self.meshes[mesh as usize].material,
             PrimRef::Sphere(s) => self.spheres[s as usize].material,
             PrimRef::Curve { curve, .. } => self.curves[curve as usize].material,
+            PrimRef::Patch { set, .. } => self.patch_sets[set as usize].material,
         }
     }
 
@@ -105,6 +118,7 @@ impl Geometry {
             PrimRef::Triangle { mesh, tri } => self.meshes[mesh as usize].surface(tri, u, v),
             PrimRef::Sphere(s) => self.spheres[s as usize].surface(ray, t),
             PrimRef::Curve { curve, seg } => self.curves[curve as usize].surface(seg, ray, t, u, v),
+            PrimRef::Patch { set, patch } => self.patch_sets[set as usize].surface(patch, u, v),
         }
     }
 
@@ -125,8 +139,8 @@ impl Geometry {
         let to_world = match self.prims[prim as usize] {
             PrimRef::Triangle { mesh, .. } => &self.meshes[mesh as usize].object_to_world,
             PrimRef::Sphere(s) => &self.spheres[s as usize].to_world,
-            // Curves are stored in world space.
-            PrimRef::Curve { .. } => return n.try_normalize().unwrap_or(n),
+            // Curves and patches are stored in world space.
+            PrimRef::Curve { .. } | PrimRef::Patch { .. } => return n.try_normalize().unwrap_or(n),
         };
         to_world.normal(n).try_normalize().unwrap_or(n)
     }
@@ -136,7 +150,7 @@ impl Geometry {
         match self.prims[prim as usize] {
             PrimRef::Triangle { mesh, .. } => self.meshes[mesh as usize].emission,
             PrimRef::Sphere(s) => self.spheres[s as usize].emission,
-            PrimRef::Curve { .. } => Rgb::ZERO,
+            PrimRef::Curve { .. } | PrimRef::Patch { .. } => Rgb::ZERO,
         }
     }
 
@@ -144,7 +158,7 @@ impl Geometry {
     pub fn emission_texture(&self, prim: u32) -> Option<TextureId> {
         match self.prims[prim as usize] {
             PrimRef::Triangle { mesh, .. } => self.meshes[mesh as usize].emission_texture,
-            PrimRef::Sphere(_) | PrimRef::Curve { .. } => None,
+            PrimRef::Sphere(_) | PrimRef::Curve { .. } | PrimRef::Patch { .. } => None,
         }
     }
 
@@ -160,7 +174,7 @@ impl Geometry {
                 let [a, b, c] = m.indices[tri as usize].map(|i| m.uvs[i as usize]);
                 (1.0 - b1 - b2) * a + b1 * b + b2 * c
             }
-            PrimRef::Sphere(_) | PrimRef::Curve { .. } => Vec2::ZERO,
+            PrimRef::Sphere(_) | PrimRef::Curve { .. } | PrimRef::Patch { .. } => Vec2::ZERO,
         }
     }
 
@@ -174,7 +188,7 @@ impl Geometry {
         }
         let n = match self.prims[prim as usize] {
             PrimRef::Triangle { mesh, tri } => self.meshes[mesh as usize].winding_normal(tri),
-            PrimRef::Sphere(_) | PrimRef::Curve { .. } => geom.ng,
+            PrimRef::Sphere(_) | PrimRef::Curve { .. } | PrimRef::Patch { .. } => geom.ng,
         };
         if n.dot(w) > 0.0 { le } else { Rgb::ZERO }
     }
@@ -194,6 +208,7 @@ impl Primitives for Geometry {
             PrimRef::Triangle { mesh, tri } => self.meshes[mesh as usize].triangle_bounds(tri),
             PrimRef::Sphere(s) => self.spheres[s as usize].bounds(),
             PrimRef::Curve { curve, seg } => self.curves[curve as usize].segment_bounds(seg),
+            PrimRef::Patch { set, patch } => self.patch_sets[set as usize].bounds(patch),
         }
     }
 
@@ -203,6 +218,7 @@ impl Primitives for Geometry {
             PrimRef::Triangle { mesh, tri } => self.meshes[mesh as usize].intersect(tri, ray).map(|(t, u, v)| PrimHit { t, u, v }),
             PrimRef::Sphere(s) => self.spheres[s as usize].intersect(ray).map(|t| PrimHit { t, u: 0.0, v: 0.0 }),
             PrimRef::Curve { curve, seg } => self.curves[curve as usize].intersect(seg, ray).map(|h| PrimHit { t: h.t, u: h.u, v: h.v }),
+            PrimRef::Patch { set, patch } => self.patch_sets[set as usize].intersect(patch, ray),
         }
     }
 

@@ -5,9 +5,10 @@
 
 use glam::DVec3;
 use raylab_accel::{PrimHit, Primitives};
-use raylab_core::{Aabb, Ray};
+use raylab_core::{gamma, Aabb, Ray, Vec2, Vec3};
 
-use super::BezierPatch;
+use super::{BezierPatch, SurfaceGeometry};
+use crate::material::MaterialId;
 
 /// Seed-grid triangles the ray misses by up to this much (in barycentrics) still seed a
 /// solve: the coarse grid's chords cut inside convex parts of the surface, so rays near a
@@ -15,9 +16,14 @@ use super::BezierPatch;
 const SEED_SLACK: f64 = 0.5;
 const NEWTON_STEPS: usize = 10;
 
+/// Seed-grid quads per patch side used by scenes: with 4×4 a few grazing rays converge to
+/// the farther of two roots; 8×8 found every root of the tessellation test.
+pub const DEFAULT_SEED_GRID: u32 = 8;
+
 /// Bicubic patches as primitives, intersected exactly (to `f64` Newton tolerance).
 #[derive(Clone, Debug)]
 pub struct PatchSurfaces {
+    pub material: MaterialId,
     patches: Vec<BezierPatch>,
     seed_grid: usize,
     /// `(seed_grid + 1)²` points per patch, row by row in `v`.
@@ -26,12 +32,33 @@ pub struct PatchSurfaces {
 
 impl PatchSurfaces {
     /// `seed_grid` quads per patch side seed the solves.
-    pub fn new(patches: Vec<BezierPatch>, seed_grid: u32) -> Self {
+    pub fn new(patches: Vec<BezierPatch>, seed_grid: u32, material: MaterialId) -> Self {
         assert!(seed_grid > 0, "the seed grid needs at least one quad");
         let n = seed_grid as usize;
         let param = |k: usize| k as f64 / n as f64;
         let seeds = patches.iter().flat_map(|p| (0..=n).flat_map(move |i| (0..=n).map(move |j| p.point_f64(param(j), param(i))))).collect();
-        Self { patches, seed_grid: n, seeds }
+        Self { material, patches, seed_grid: n, seeds }
+    }
+
+    pub fn len(&self) -> usize {
+        self.patches.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.patches.is_empty()
+    }
+
+    /// Surface data at `(u, v)` of patch `i`: the point and normal of the bicubic itself
+    /// (exact normals, including at the poles; `ns = ng`).
+    pub fn surface(&self, i: u32, u: f32, v: f32) -> SurfaceGeometry {
+        let patch = &self.patches[i as usize];
+        let p = patch.point(u, v);
+        let (dpdu, dpdv) = patch.derivatives(u, v);
+        let n = patch.normal(u, v);
+        // Newton stops within 1e-9 of the patch size in f64; rounding (u, v) and the
+        // evaluation to f32 adds a few ulps of the coordinates.
+        let p_error = gamma(8) * p.abs() + Vec3::splat(1e-6 * patch.size() as f32);
+        SurfaceGeometry { p, p_error, ng: n, ns: n, uv: Vec2::new(u, v), dpdu, dpdv }
     }
 
     pub fn patch(&self, i: u32) -> &BezierPatch {
@@ -139,7 +166,7 @@ mod tests {
 
     #[test]
     fn ray_down_onto_the_dome_hits_its_height() {
-        let s = PatchSurfaces::new(vec![dome()], 2);
+        let s = PatchSurfaces::new(vec![dome()], 2, MaterialId::default());
         let (t, u, v) = s.intersect_patch(0, &Ray::new(Vec3::new(1.0, 1.5, 5.0), -Vec3::Z)).unwrap();
         assert!((t - (5.0 - 0.5625)).abs() < 1e-6 && (u - 0.5).abs() < 1e-6 && (v - 0.5).abs() < 1e-6, "{t} {u} {v}");
         // At (u, v) = (0.25, 0.5): z = (36/64)(0.75).
@@ -149,7 +176,7 @@ mod tests {
 
     #[test]
     fn closest_of_two_hits_and_the_ray_interval() {
-        let s = PatchSurfaces::new(vec![dome()], 2);
+        let s = PatchSurfaces::new(vec![dome()], 2, MaterialId::default());
         // Sideways through the dome at x = 1, z = 0.3: in at one flank, out at the other.
         let ray = Ray::new(Vec3::new(1.0, -1.0, 0.3), Vec3::Y);
         let (t_in, _, v_in) = s.intersect_patch(0, &ray).unwrap();
