@@ -69,6 +69,8 @@ struct Counts {
     /// Strands of directly intersected curves, and their Bézier segments (primitives).
     curves: usize,
     curve_segments: usize,
+    /// Bicubic patches intersected directly (one primitive each).
+    patches: usize,
     materials: usize,
     textures: usize,
     lights: usize,
@@ -104,6 +106,7 @@ fn report(name: String, scene: &Scene) -> Report {
     let geometry_bytes = g.meshes.iter().map(|m| m.positions.len() * 12 + m.normals.len() * 12 + m.uvs.len() * 8 + m.tangents.len() * 16 + m.indices.len() * 12).sum::<usize>()
         + g.spheres.len() * std::mem::size_of::<raylab_render::Sphere>()
         + g.curves.iter().map(|c| c.memory_bytes()).sum::<usize>()
+        + g.patch_sets.iter().map(|p| p.memory_bytes()).sum::<usize>()
         + g.len() * 8;
     let texture_bytes = scene.textures.iter().map(|t| match t {
         raylab_render::Texture::Image(i) => i.width() as usize * i.height() as usize * std::mem::size_of::<raylab_core::Rgb>(),
@@ -123,13 +126,14 @@ fn report(name: String, scene: &Scene) -> Report {
             seed: s.seed,
         },
         counts: Counts {
-            shapes: g.meshes.len() + g.spheres.len() + g.curves.len(),
+            shapes: g.meshes.len() + g.spheres.len() + g.curves.len() + g.patch_sets.len(),
             primitives: g.len(),
             triangles: g.triangle_count(),
             spheres: g.spheres.len(),
             meshes: g.meshes.len(),
             curves: g.curves.len(),
             curve_segments: g.curves.iter().map(|c| c.len()).sum(),
+            patches: g.patch_sets.iter().map(|p| p.len()).sum(),
             materials: scene.materials.len(),
             textures: scene.textures.len(),
             lights: scene.lights.len(),
@@ -191,8 +195,8 @@ pub fn run(a: &InspectArgs) -> Result<()> {
     println!("render      {}×{}, {} spp ({}), integrator {}, max depth {}, accel {}, seed {}", s.width, s.height, s.spp, s.sampler, s.integrator, s.max_depth, s.accel, s.seed);
     let n = &r.counts;
     println!(
-        "contents    {} shapes: {} meshes ({} triangles), {} spheres, {} curves ({} segments); {} materials, {} textures, {} lights, {} emitting primitives",
-        n.shapes, n.meshes, n.triangles, n.spheres, n.curves, n.curve_segments, n.materials, n.textures, n.lights, n.area_light_primitives
+        "contents    {} shapes: {} meshes ({} triangles), {} spheres, {} curves ({} segments), {} patches; {} materials, {} textures, {} lights, {} emitting primitives",
+        n.shapes, n.meshes, n.triangles, n.spheres, n.curves, n.curve_segments, n.patches, n.materials, n.textures, n.lights, n.area_light_primitives
     );
     println!("bounds      {:?} .. {:?}", r.bounds[0], r.bounds[1]);
     println!("memory      geometry {:.1} KiB, textures {:.1} KiB, acceleration structure {:.1} KiB", r.geometry_bytes as f64 / 1024.0, r.texture_bytes as f64 / 1024.0, r.accel.memory_bytes as f64 / 1024.0);

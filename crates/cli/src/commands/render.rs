@@ -96,7 +96,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             let c = &output.counters;
             let per_ray = |n: u64| n as f64 / c.rays.max(1) as f64;
             eprintln!(
-                "Rendered {} at {}×{}, {} spp ({}), integrator {}, max depth {}: {} primitives ({} triangles, {} spheres, {} curve segments), {} lights; \
+                "Rendered {} at {}×{}, {} spp ({}), integrator {}, max depth {}: {} primitives ({} triangles, {} spheres, {} curve segments, {} patches), {} lights; \
                  {} acceleration structure built in {:.1} ms after {:.2} s of loading. Traced {:.2} M rays in {:.2} s ({:.2} Mrays/s on {threads} threads){}; per ray {:.1} nodes visited and {:.1} primitive tests. Wrote {}.",
                 a.scene.scene_name(),
                 s.width,
@@ -109,6 +109,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
                 g.triangle_count(),
                 g.spheres.len(),
                 g.curves.iter().map(|c| c.len()).sum::<usize>(),
+                g.patch_sets.iter().map(|p| p.len()).sum::<usize>(),
                 scene.lights.len() + scene.area_lights.len() + scene.environment.is_some() as usize,
                 stats.name,
                 stats.build_ms,

@@ -48,6 +48,11 @@ impl PatchSurfaces {
         self.patches.is_empty()
     }
 
+    /// Bytes held: control points and seed grids.
+    pub fn memory_bytes(&self) -> usize {
+        self.patches.len() * std::mem::size_of::<BezierPatch>() + self.seeds.len() * std::mem::size_of::<DVec3>()
+    }
+
     /// Surface data at `(u, v)` of patch `i`: the point and normal of the bicubic itself
     /// (exact normals, including at the poles; `ns = ng`).
     pub fn surface(&self, i: u32, u: f32, v: f32) -> SurfaceGeometry {
