@@ -7,6 +7,8 @@ pub mod color;
 pub mod distribution;
 pub mod frame;
 pub mod intersect;
+#[macro_use]
+pub mod named;
 pub mod offset;
 pub mod ray;
 pub mod rng;

@@ -2,9 +2,6 @@
 //! lights. Generated once per scene (with a reference structure) and traced by every
 //! structure, so that all of them answer exactly the same queries.
 
-use std::fmt;
-use std::str::FromStr;
-
 use rayon::prelude::*;
 use raylab_accel::Counters;
 use raylab_core::{sampling, Frame, Pcg32, Ray, Vec2};
@@ -21,33 +18,16 @@ pub enum RayKind {
     Shadow,
 }
 
+raylab_core::named_enum!(RayKind, "ray kind", {
+    Primary => "primary",
+    Diffuse => "diffuse",
+    Shadow => "shadow",
+});
+
 impl RayKind {
-    pub const ALL: &'static [RayKind] = &[RayKind::Primary, RayKind::Diffuse, RayKind::Shadow];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            RayKind::Primary => "primary",
-            RayKind::Diffuse => "diffuse",
-            RayKind::Shadow => "shadow",
-        }
-    }
-
     /// Shadow rays ask "is anything there?", the others "what is hit first?".
     pub fn any_hit(self) -> bool {
         self == RayKind::Shadow
-    }
-}
-
-impl fmt::Display for RayKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for RayKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL.iter().copied().find(|k| k.name() == s).ok_or_else(|| format!("unknown ray kind `{s}` (valid: primary, diffuse, shadow)"))
     }
 }
 

@@ -2,8 +2,6 @@
 //! sample's film offset is drawn from the filter itself, so every sample has weight 1 and a
 //! pixel is the plain mean of its samples. The box filter is the pixel's square.
 
-use std::fmt;
-use std::str::FromStr;
 use std::sync::OnceLock;
 
 use raylab_core::Vec2;
@@ -19,20 +17,16 @@ pub enum PixelFilter {
     Gaussian,
 }
 
+raylab_core::named_enum!(PixelFilter, "pixel filter", {
+    Box => "box",
+    Tent => "tent",
+    Gaussian => "gaussian",
+});
+
 const GAUSSIAN_SIGMA: f32 = 0.5;
 const GAUSSIAN_RADIUS: f32 = 1.5;
 
 impl PixelFilter {
-    pub const ALL: &'static [PixelFilter] = &[PixelFilter::Box, PixelFilter::Tent, PixelFilter::Gaussian];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            PixelFilter::Box => "box",
-            PixelFilter::Tent => "tent",
-            PixelFilter::Gaussian => "gaussian",
-        }
-    }
-
     /// The film offset from the pixel's centre for a uniform sample `u` in `[0,1)²`.
     pub fn offset(self, u: Vec2) -> Vec2 {
         match self {
@@ -67,20 +61,6 @@ fn gaussian(u: f32) -> f32 {
     let i = cdf.partition_point(|&c| c <= u).clamp(1, N) - 1;
     let t = (u - cdf[i]) / (cdf[i + 1] - cdf[i]).max(f32::MIN_POSITIVE);
     -GAUSSIAN_RADIUS + (i as f32 + t.clamp(0.0, 1.0)) * (2.0 * GAUSSIAN_RADIUS / N as f32)
-}
-
-impl fmt::Display for PixelFilter {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for PixelFilter {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        let names: Vec<&str> = Self::ALL.iter().map(|f| f.name()).collect();
-        Self::ALL.iter().copied().find(|f| f.name() == s).ok_or_else(|| format!("unknown pixel filter `{s}` (valid: {})", names.join(", ")))
-    }
 }
 
 #[cfg(test)]

@@ -10,9 +10,6 @@
 //!   index-shuffled per pixel and dimension (pbrt-v4's `PaddedSobolSampler`), so any power
 //!   of two `spp` is a (0,m,2)-net in every pair of dimensions.
 
-use std::fmt;
-use std::str::FromStr;
-
 use raylab_core::rng::mix64;
 use raylab_core::{sampling, Pcg32, Vec2};
 
@@ -23,21 +20,13 @@ pub enum SamplerKind {
     Sobol,
 }
 
+raylab_core::named_enum!(SamplerKind, "sampler", {
+    Random => "random",
+    Jittered => "jittered",
+    Sobol => "sobol",
+});
+
 impl SamplerKind {
-    pub const ALL: &'static [SamplerKind] = &[SamplerKind::Random, SamplerKind::Jittered, SamplerKind::Sobol];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            SamplerKind::Random => "random",
-            SamplerKind::Jittered => "jittered",
-            SamplerKind::Sobol => "sobol",
-        }
-    }
-
-    pub fn names() -> String {
-        Self::ALL.iter().map(|k| k.name()).collect::<Vec<_>>().join(", ")
-    }
-
     /// Checks that `spp` suits the sampler.
     pub fn check_spp(self, spp: u32) -> Result<(), String> {
         if spp == 0 {
@@ -50,19 +39,6 @@ impl SamplerKind {
             }
         }
         Ok(())
-    }
-}
-
-impl fmt::Display for SamplerKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for SamplerKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL.iter().copied().find(|k| k.name() == s).ok_or_else(|| format!("unknown sampler `{s}` (valid: {})", Self::names()))
     }
 }
 

@@ -5,8 +5,6 @@
 //! infinite, the width parameter with the same role (both peak at D(z) = 1/(πα²)).
 
 use std::f32::consts::{FRAC_1_PI, PI};
-use std::fmt;
-use std::str::FromStr;
 
 use raylab_core::{Rgb, Vec2, Vec3};
 
@@ -25,6 +23,11 @@ pub enum Distribution {
     Ggx,
 }
 
+raylab_core::named_enum!(Distribution, "microfacet distribution", {
+    Beckmann => "beckmann",
+    Ggx => "ggx",
+});
+
 /// Masking–shadowing term G(wo, wi).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Geometry {
@@ -38,16 +41,12 @@ pub enum Geometry {
     VCavity,
 }
 
+raylab_core::named_enum!(Geometry, "geometry term", {
+    Smith => "smith",
+    VCavity => "v-cavity",
+});
+
 impl Distribution {
-    pub const ALL: &'static [Distribution] = &[Distribution::Beckmann, Distribution::Ggx];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Distribution::Beckmann => "beckmann",
-            Distribution::Ggx => "ggx",
-        }
-    }
-
     /// D(h) for a unit half vector `h`; zero below the horizon.
     pub(super) fn d(self, h: Vec3, alpha: f32) -> f32 {
         if h.z <= 0.0 {
@@ -110,15 +109,6 @@ impl Distribution {
 }
 
 impl Geometry {
-    pub const ALL: &'static [Geometry] = &[Geometry::Smith, Geometry::VCavity];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Geometry::Smith => "smith",
-            Geometry::VCavity => "v-cavity",
-        }
-    }
-
     /// G(wo, wi) for a reflection configuration: `wo.z, wi.z > 0`, `h` their half vector.
     pub(super) fn g(self, distribution: Distribution, alpha: f32, wo: Vec3, wi: Vec3, h: Vec3) -> f32 {
         match self {
@@ -141,28 +131,3 @@ pub(super) fn schlick(f0: Rgb, cos: f32) -> Rgb {
     f0 + (Rgb::ONE - f0) * (m2 * m2 * m)
 }
 
-impl fmt::Display for Distribution {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl fmt::Display for Geometry {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Distribution {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL.iter().copied().find(|d| d.name() == s).ok_or_else(|| format!("unknown microfacet distribution `{s}` (valid: beckmann, ggx)"))
-    }
-}
-
-impl FromStr for Geometry {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL.iter().copied().find(|g| g.name() == s).ok_or_else(|| format!("unknown geometry term `{s}` (valid: smith, v-cavity)"))
-    }
-}

@@ -1,8 +1,5 @@
 //! The integrators by name: `[render] integrator` and `--integrator`.
 
-use std::fmt;
-use std::str::FromStr;
-
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum IntegratorKind {
     /// Recursive ray tracing (Whitted 1980): Phong with point lights, shadows, mirror
@@ -25,50 +22,22 @@ pub enum IntegratorKind {
     HeatmapTests,
 }
 
+raylab_core::named_enum!(IntegratorKind, "integrator", {
+    Whitted => "whitted",
+    Direct => "direct",
+    Path => "path",
+    Normals => "normals",
+    Albedo => "albedo",
+    Depth => "depth",
+    Heatmap => "heatmap",
+    HeatmapTests => "heatmap-tests",
+});
+
 impl IntegratorKind {
-    pub const ALL: &'static [IntegratorKind] = &[
-        IntegratorKind::Whitted,
-        IntegratorKind::Direct,
-        IntegratorKind::Path,
-        IntegratorKind::Normals,
-        IntegratorKind::Albedo,
-        IntegratorKind::Depth,
-        IntegratorKind::Heatmap,
-        IntegratorKind::HeatmapTests,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            IntegratorKind::Whitted => "whitted",
-            IntegratorKind::Direct => "direct",
-            IntegratorKind::Path => "path",
-            IntegratorKind::Normals => "normals",
-            IntegratorKind::Albedo => "albedo",
-            IntegratorKind::Depth => "depth",
-            IntegratorKind::Heatmap => "heatmap",
-            IntegratorKind::HeatmapTests => "heatmap-tests",
-        }
-    }
-
     /// Whether the output holds raw costs to be colourised by [`super::heatmap::colorize`].
     pub fn is_heatmap(self) -> bool {
         matches!(self, IntegratorKind::Heatmap | IntegratorKind::HeatmapTests)
     }
 
-    pub fn names() -> String {
-        Self::ALL.iter().map(|k| k.name()).collect::<Vec<_>>().join(", ")
-    }
 }
 
-impl fmt::Display for IntegratorKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for IntegratorKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL.iter().copied().find(|k| k.name() == s).ok_or_else(|| format!("unknown integrator `{s}` (valid: {})", Self::names()))
-    }
-}

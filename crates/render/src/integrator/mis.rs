@@ -1,8 +1,5 @@
 //! Multiple importance sampling weights (Veach 1997, §9.2): `[render] mis_heuristic`.
 
-use std::fmt;
-use std::str::FromStr;
-
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MisHeuristic {
     /// `f / (f + g)`: provably close to optimal among all weightings.
@@ -11,16 +8,12 @@ pub enum MisHeuristic {
     Power,
 }
 
+raylab_core::named_enum!(MisHeuristic, "MIS heuristic", {
+    Power => "power",
+    Balance => "balance",
+});
+
 impl MisHeuristic {
-    pub const ALL: &'static [MisHeuristic] = &[MisHeuristic::Power, MisHeuristic::Balance];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            MisHeuristic::Balance => "balance",
-            MisHeuristic::Power => "power",
-        }
-    }
-
     /// The weight of a sample drawn with density `f` when `g` is the other strategy's
     /// density for the same direction (one sample from each).
     pub fn weight(self, f: f32, g: f32) -> f32 {
@@ -35,19 +28,6 @@ impl MisHeuristic {
         } else {
             f / (f + g)
         }
-    }
-}
-
-impl fmt::Display for MisHeuristic {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for MisHeuristic {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL.iter().copied().find(|h| h.name() == s).ok_or_else(|| format!("unknown MIS heuristic `{s}` (valid: power, balance)"))
     }
 }
 

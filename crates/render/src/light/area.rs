@@ -4,8 +4,6 @@
 //! the same density for a direction found by BSDF sampling, for multiple importance sampling.
 
 use std::f32::consts::PI;
-use std::fmt;
-use std::str::FromStr;
 
 use raylab_core::color::luminance;
 use raylab_core::{sampling, Frame, Rgb, Vec2, Vec3};
@@ -35,39 +33,18 @@ pub enum LightSampling {
     Mis,
 }
 
+raylab_core::named_enum!(LightSampling, "light sampling", {
+    Uniform => "uniform",
+    SolidAngle => "solid-angle",
+    Cells => "cells",
+    Bsdf => "bsdf",
+    Mis => "mis",
+});
+
 impl LightSampling {
-    pub const ALL: &'static [LightSampling] = &[LightSampling::Uniform, LightSampling::SolidAngle, LightSampling::Cells, LightSampling::Bsdf, LightSampling::Mis];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            LightSampling::Uniform => "uniform",
-            LightSampling::SolidAngle => "solid-angle",
-            LightSampling::Cells => "cells",
-            LightSampling::Bsdf => "bsdf",
-            LightSampling::Mis => "mis",
-        }
-    }
-
-    pub fn names() -> String {
-        Self::ALL.iter().map(|k| k.name()).collect::<Vec<_>>().join(", ")
-    }
-
     /// Whether light sampling is used at all.
     pub fn samples_lights(self) -> bool {
         self != LightSampling::Bsdf
-    }
-}
-
-impl fmt::Display for LightSampling {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for LightSampling {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL.iter().copied().find(|k| k.name() == s).ok_or_else(|| format!("unknown light sampling `{s}` (valid: {})", Self::names()))
     }
 }
 

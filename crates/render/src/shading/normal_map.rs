@@ -1,5 +1,3 @@
-use std::fmt;
-use std::str::FromStr;
 
 use raylab_core::{Rgb, Vec3};
 
@@ -14,30 +12,10 @@ pub enum NormalSpace {
     Object,
 }
 
-impl NormalSpace {
-    pub const ALL: [NormalSpace; 2] = [NormalSpace::Tangent, NormalSpace::Object];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            NormalSpace::Tangent => "tangent",
-            NormalSpace::Object => "object",
-        }
-    }
-}
-
-impl FromStr for NormalSpace {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, String> {
-        NormalSpace::ALL.into_iter().find(|n| n.name() == s).ok_or_else(|| format!("unknown normal space `{s}` (valid: {})", NormalSpace::ALL.map(NormalSpace::name).join(", ")))
-    }
-}
-
-impl fmt::Display for NormalSpace {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
+raylab_core::named_enum!(NormalSpace, "normal space", {
+    Tangent => "tangent",
+    Object => "object",
+});
 
 /// A texel `c` in `[0, 1]³` (linear, never sRGB-decoded) to the unit normal `2c − 1`,
 /// renormalised because filtering and 8-bit storage shorten it. A black texel gives `+z`.

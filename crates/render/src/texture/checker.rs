@@ -4,9 +4,6 @@
 //! The board is unfiltered, like the book's and pbrt-v4's `NoAA` mode: it aliases under
 //! minification, which pixel supersampling averages away.
 
-use std::fmt;
-use std::str::FromStr;
-
 use raylab_core::{Rgb, Vec2, Vec3};
 
 /// Where a [`Checker`] lays its grid.
@@ -19,35 +16,10 @@ pub enum CheckerSpace {
     Solid,
 }
 
-impl CheckerSpace {
-    /// Every space, in the order the error messages list them.
-    pub const ALL: [CheckerSpace; 2] = [CheckerSpace::Uv, CheckerSpace::Solid];
-
-    /// The name used in scene files.
-    pub fn name(self) -> &'static str {
-        match self {
-            CheckerSpace::Uv => "uv",
-            CheckerSpace::Solid => "solid",
-        }
-    }
-}
-
-impl FromStr for CheckerSpace {
-    type Err = String;
-
-    /// Parses a scene-file name; the error lists the valid names.
-    fn from_str(s: &str) -> Result<Self, String> {
-        CheckerSpace::ALL.into_iter().find(|c| c.name() == s).ok_or_else(|| {
-            format!("unknown checker space `{s}` (valid: {})", CheckerSpace::ALL.map(CheckerSpace::name).join(", "))
-        })
-    }
-}
-
-impl fmt::Display for CheckerSpace {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
+raylab_core::named_enum!(CheckerSpace, "checker space", {
+    Uv => "uv",
+    Solid => "solid",
+});
 
 /// Two colours on a grid of `1 / scale`-sized cells.
 #[derive(Clone, Copy, Debug, PartialEq)]

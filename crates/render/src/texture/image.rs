@@ -4,9 +4,6 @@
 //! at `x + 0.5` (Heckbert's convention, pbrt-v4 `Image::Bilerp`): bilinear filtering therefore
 //! looks up `u·w - 0.5`, and a lookup exactly at a texel centre returns that texel unblended.
 
-use std::fmt;
-use std::str::FromStr;
-
 use raylab_core::{Rgb, Vec2};
 
 /// What a lookup outside `[0, 1]` sees.
@@ -21,19 +18,13 @@ pub enum Wrap {
     Mirror,
 }
 
+raylab_core::named_enum!(Wrap, "wrap mode", {
+    Repeat => "repeat",
+    Clamp => "clamp",
+    Mirror => "mirror",
+});
+
 impl Wrap {
-    /// Every wrap mode, in the order the error messages list them.
-    pub const ALL: [Wrap; 3] = [Wrap::Repeat, Wrap::Clamp, Wrap::Mirror];
-
-    /// The name used in scene files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Wrap::Repeat => "repeat",
-            Wrap::Clamp => "clamp",
-            Wrap::Mirror => "mirror",
-        }
-    }
-
     /// Maps an integer texel index onto `0..n` (`n > 0`).
     #[inline]
     fn index(self, i: i64, n: i64) -> usize {
@@ -50,23 +41,6 @@ impl Wrap {
     }
 }
 
-impl FromStr for Wrap {
-    type Err = String;
-
-    /// Parses a scene-file name; the error lists the valid names.
-    fn from_str(s: &str) -> Result<Self, String> {
-        Wrap::ALL.into_iter().find(|w| w.name() == s).ok_or_else(|| {
-            format!("unknown wrap mode `{s}` (valid: {})", Wrap::ALL.map(Wrap::name).join(", "))
-        })
-    }
-}
-
-impl fmt::Display for Wrap {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
 /// How a lookup between texel centres is reconstructed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Filter {
@@ -77,35 +51,10 @@ pub enum Filter {
     Bilinear,
 }
 
-impl Filter {
-    /// Every filter, in the order the error messages list them.
-    pub const ALL: [Filter; 2] = [Filter::Nearest, Filter::Bilinear];
-
-    /// The name used in scene files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Filter::Nearest => "nearest",
-            Filter::Bilinear => "bilinear",
-        }
-    }
-}
-
-impl FromStr for Filter {
-    type Err = String;
-
-    /// Parses a scene-file name; the error lists the valid names.
-    fn from_str(s: &str) -> Result<Self, String> {
-        Filter::ALL.into_iter().find(|w| w.name() == s).ok_or_else(|| {
-            format!("unknown texture filter `{s}` (valid: {})", Filter::ALL.map(Filter::name).join(", "))
-        })
-    }
-}
-
-impl fmt::Display for Filter {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
+raylab_core::named_enum!(Filter, "texture filter", {
+    Nearest => "nearest",
+    Bilinear => "bilinear",
+});
 
 /// A linear-RGB bitmap with a wrap mode and a filter.
 #[derive(Clone, Debug)]
@@ -264,7 +213,7 @@ mod tests {
     #[test]
     fn wrap_modes_outside_the_unit_square() {
         // v = 0.25 is the centre of the bottom row (C D) for both filters.
-        for filter in Filter::ALL {
+        for &filter in Filter::ALL {
             let at = |wrap, u| tex(wrap, filter).lookup(Vec2::new(u, 0.25));
             // u = -0.25: x = -0.5 (nearest) or -1.0 (bilinear), one texel left of the image.
             assert_close(at(Wrap::Repeat, -0.25), D);
@@ -299,8 +248,8 @@ mod tests {
 
     #[test]
     fn hostile_uv_never_panics() {
-        for filter in Filter::ALL {
-            for wrap in Wrap::ALL {
+        for &filter in Filter::ALL {
+            for &wrap in Wrap::ALL {
                 let t = tex(wrap, filter);
                 for u in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, f32::MAX, f32::MIN, -1e30, 1e30] {
                     let c = t.lookup(Vec2::new(u, u));
@@ -330,10 +279,10 @@ mod tests {
 
     #[test]
     fn names_parse_and_errors_list_them() {
-        for w in Wrap::ALL {
+        for &w in Wrap::ALL {
             assert_eq!(w.name().parse::<Wrap>(), Ok(w));
         }
-        for f in Filter::ALL {
+        for &f in Filter::ALL {
             assert_eq!(f.name().parse::<Filter>(), Ok(f));
         }
         assert_eq!("tile".parse::<Wrap>().unwrap_err(), "unknown wrap mode `tile` (valid: repeat, clamp, mirror)");

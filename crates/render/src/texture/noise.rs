@@ -5,8 +5,6 @@
 //! render the same marble, and two noise textures in one scene can differ.
 
 use std::f32::consts::TAU;
-use std::fmt;
-use std::str::FromStr;
 
 use raylab_core::{Pcg32, Rgb, Vec3};
 
@@ -26,37 +24,12 @@ pub enum NoiseKind {
     Wood,
 }
 
-impl NoiseKind {
-    /// Every kind, in the order the error messages list them.
-    pub const ALL: [NoiseKind; 4] = [NoiseKind::Plain, NoiseKind::Turbulence, NoiseKind::Marble, NoiseKind::Wood];
-
-    /// The name used in scene files.
-    pub fn name(self) -> &'static str {
-        match self {
-            NoiseKind::Plain => "plain",
-            NoiseKind::Turbulence => "turbulence",
-            NoiseKind::Marble => "marble",
-            NoiseKind::Wood => "wood",
-        }
-    }
-}
-
-impl FromStr for NoiseKind {
-    type Err = String;
-
-    /// Parses a scene-file name; the error lists the valid names.
-    fn from_str(s: &str) -> Result<Self, String> {
-        NoiseKind::ALL.into_iter().find(|k| k.name() == s).ok_or_else(|| {
-            format!("unknown noise kind `{s}` (valid: {})", NoiseKind::ALL.map(NoiseKind::name).join(", "))
-        })
-    }
-}
-
-impl fmt::Display for NoiseKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
+raylab_core::named_enum!(NoiseKind, "noise kind", {
+    Plain => "plain",
+    Turbulence => "turbulence",
+    Marble => "marble",
+    Wood => "wood",
+});
 
 /// Octaves beyond this add less than 2^-16 of the signal, below any 8-bit or half-float output.
 const MAX_OCTAVES: u32 = 16;
@@ -195,7 +168,7 @@ mod tests {
 
     #[test]
     fn deterministic_per_seed_and_seeds_differ() {
-        for kind in NoiseKind::ALL {
+        for &kind in NoiseKind::ALL {
             let a = Noise::new(kind, 3.0, BW, 7, 42);
             let b = Noise::new(kind, 3.0, BW, 7, 42);
             let c = Noise::new(kind, 3.0, BW, 7, 43);
@@ -210,7 +183,7 @@ mod tests {
 
     #[test]
     fn values_in_unit_interval_and_not_constant() {
-        for kind in NoiseKind::ALL {
+        for &kind in NoiseKind::ALL {
             let n = Noise::new(kind, 4.0, BW, 7, 1);
             let (mut lo, mut hi) = (f32::MAX, f32::MIN);
             for p in points(20_000) {
@@ -245,7 +218,7 @@ mod tests {
         // Period 256 on the lattice, and garbage input stays finite.
         let p = Vec3::new(0.3, 0.6, 0.9);
         assert!((n.noise(p) - n.noise(p + Vec3::new(256.0, 0.0, -512.0))).abs() < 1e-3);
-        for kind in NoiseKind::ALL {
+        for &kind in NoiseKind::ALL {
             let n = Noise::new(kind, 1.0, BW, 40, 9);
             for p in [Vec3::splat(f32::NAN), Vec3::new(f32::INFINITY, f32::NEG_INFINITY, 1e30)] {
                 assert!((0.0..=1.0).contains(&n.value(p)));
@@ -264,7 +237,7 @@ mod tests {
 
     #[test]
     fn names_parse() {
-        for k in NoiseKind::ALL {
+        for &k in NoiseKind::ALL {
             assert_eq!(k.name().parse(), Ok(k));
         }
         assert_eq!(
