@@ -62,36 +62,34 @@ pub struct Geometry {
 }
 
 impl Geometry {
+    /// Appends one object's primitives (consecutive, so the object is one range).
+    fn push_object(&mut self, prims: impl IntoIterator<Item = PrimRef>) {
+        let start = self.prims.len() as u32;
+        self.prims.extend(prims);
+        self.objects.push(start..self.prims.len() as u32);
+    }
+
     pub fn add_mesh(&mut self, mesh: TriangleMesh) {
         let m = self.meshes.len() as u32;
-        let start = self.prims.len() as u32;
-        self.prims.extend((0..mesh.len() as u32).map(|tri| PrimRef::Triangle { mesh: m, tri }));
-        self.objects.push(start..self.prims.len() as u32);
+        self.push_object((0..mesh.len() as u32).map(|tri| PrimRef::Triangle { mesh: m, tri }));
         self.meshes.push(mesh);
     }
 
     pub fn add_sphere(&mut self, sphere: Sphere) {
-        let s = self.spheres.len() as u32;
-        let start = self.prims.len() as u32;
-        self.prims.push(PrimRef::Sphere(s));
-        self.objects.push(start..start + 1);
+        self.push_object([PrimRef::Sphere(self.spheres.len() as u32)]);
         self.spheres.push(sphere);
     }
 
     pub fn add_curve(&mut self, curve: Curve) {
         let c = self.curves.len() as u32;
-        let start = self.prims.len() as u32;
-        self.prims.extend((0..curve.len() as u32).map(|seg| PrimRef::Curve { curve: c, seg }));
-        self.objects.push(start..self.prims.len() as u32);
+        self.push_object((0..curve.len() as u32).map(|seg| PrimRef::Curve { curve: c, seg }));
         self.curves.push(curve);
     }
 
     /// Bicubic patches intersected directly; the set is one object.
     pub fn add_patches(&mut self, set: PatchSurfaces) {
         let s = self.patch_sets.len() as u32;
-        let start = self.prims.len() as u32;
-        self.prims.extend((0..set.len() as u32).map(|patch| PrimRef::Patch { set: s, patch }));
-        self.objects.push(start..self.prims.len() as u32);
+        self.push_object((0..set.len() as u32).map(|patch| PrimRef::Patch { set: s, patch }));
         self.patch_sets.push(set);
     }
 
