@@ -9,8 +9,7 @@ use raylab_render::{MaterialId, Scene};
 
 use crate::error::{text_from_bytes, LoadError};
 use crate::files::Found;
-use crate::scene::in_range;
-use crate::toml_read::{Table, Val};
+use crate::toml_read::{in_range, Table, Val};
 
 /// The keys of a curve shape besides `type`, `material` and `transform`.
 pub const KEYS: &[&str] = &["points", "radius", "basis", "degree", "file", "mode", "segments", "sides"];

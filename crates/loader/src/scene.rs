@@ -21,7 +21,7 @@ use crate::error::LoadError;
 use crate::files::{not_found_message, Found, Resolver};
 use crate::obj::{load_obj, mtl_color, MtlMaterial};
 use crate::patches::{load_patch_mesh, load_patches_world};
-use crate::toml_read::{Doc, Table, Val};
+use crate::toml_read::{in_range, in_range_f32, positive, Doc, Table, Val};
 
 /// Values from the command line that replace the scene's before anything is built.
 #[derive(Clone, Debug, Default)]
@@ -129,30 +129,6 @@ struct Builder<'a> {
     mtl_cache: HashMap<(String, usize), MaterialId>,
     /// Whether the scene has a `[background]` table (an environment light replaces it).
     has_background: bool,
-}
-
-fn positive(v: &Val, x: f32) -> Result<f32, LoadError> {
-    if x > 0.0 {
-        Ok(x)
-    } else {
-        Err(v.err(format!("must be positive, found {x}")))
-    }
-}
-
-pub(crate) fn in_range(v: &Val, x: i64, lo: i64, hi: i64) -> Result<i64, LoadError> {
-    if (lo..=hi).contains(&x) {
-        Ok(x)
-    } else {
-        Err(v.err(format!("must be between {lo} and {hi}, found {x}")))
-    }
-}
-
-fn in_range_f32(v: &Val, x: f32, lo: f32, hi: f32) -> Result<f32, LoadError> {
-    if (lo..=hi).contains(&x) {
-        Ok(x)
-    } else {
-        Err(v.err(format!("must be between {lo} and {hi}, found {x}")))
-    }
 }
 
 impl Builder<'_> {

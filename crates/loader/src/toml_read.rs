@@ -242,3 +242,28 @@ impl<'a, 'i> Table<'a, 'i> {
         }
     }
 }
+
+/// Range checks of values, with the messages every field shares.
+pub(crate) fn positive(v: &Val, x: f32) -> Result<f32, LoadError> {
+    if x > 0.0 {
+        Ok(x)
+    } else {
+        Err(v.err(format!("must be positive, found {x}")))
+    }
+}
+
+pub(crate) fn in_range(v: &Val, x: i64, lo: i64, hi: i64) -> Result<i64, LoadError> {
+    if (lo..=hi).contains(&x) {
+        Ok(x)
+    } else {
+        Err(v.err(format!("must be between {lo} and {hi}, found {x}")))
+    }
+}
+
+pub(crate) fn in_range_f32(v: &Val, x: f32, lo: f32, hi: f32) -> Result<f32, LoadError> {
+    if (lo..=hi).contains(&x) {
+        Ok(x)
+    } else {
+        Err(v.err(format!("must be between {lo} and {hi}, found {x}")))
+    }
+}

@@ -4,7 +4,7 @@ use raylab_core::{offset_ray_origin, Ray, Rgb, Vec3};
 use crate::camera::Camera;
 use crate::filter::PixelFilter;
 use crate::integrator::kind::IntegratorKind;
-use crate::integrator::MisHeuristic;
+use crate::integrator::mis::MisHeuristic;
 use crate::light::{AreaLights, EnvironmentLight, Light, LightSampling};
 use crate::material::{Material, MaterialId, TextureId};
 use crate::sampler::SamplerKind;
