@@ -28,7 +28,16 @@ pub struct PatchSurfaces {
     seed_grid: usize,
     /// `(seed_grid + 1)²` points per patch, row by row in `v`.
     seeds: Vec<DVec3>,
+    /// Per patch, per seed quad (row by row): the box any point a seed triangle of the quad
+    /// can report lies in (its triangles grown by [`SEED_SLACK`]). A line missing it
+    /// cannot seed a solve there, so most quads are skipped with one slab test.
+    quad_reach: Vec<(DVec3, DVec3)>,
+    /// The union of the reach boxes of each block of `BLOCK × BLOCK` quads.
+    block_reach: Vec<(DVec3, DVec3)>,
 }
+
+/// Seed quads per side of a culling block.
+const BLOCK: usize = 4;
 
 impl PatchSurfaces {
     /// `seed_grid` quads per patch side seed the solves.
@@ -36,8 +45,33 @@ impl PatchSurfaces {
         assert!(seed_grid > 0, "the seed grid needs at least one quad");
         let n = seed_grid as usize;
         let param = |k: usize| k as f64 / n as f64;
-        let seeds = patches.iter().flat_map(|p| (0..=n).flat_map(move |i| (0..=n).map(move |j| p.point_f64(param(j), param(i))))).collect();
-        Self { material, patches, seed_grid: n, seeds }
+        let seeds: Vec<DVec3> = patches.iter().flat_map(|p| (0..=n).flat_map(move |i| (0..=n).map(move |j| p.point_f64(param(j), param(i))))).collect();
+        let side = n + 1;
+        let blocks = n.div_ceil(BLOCK);
+        let (mut quad_reach, mut block_reach) = (Vec::new(), Vec::new());
+        for grid in seeds.chunks(side * side) {
+            let quads: Vec<(DVec3, DVec3)> = (0..n * n).map(|q| {
+                let (row, col) = (q / n, q % n);
+                let c = |di: usize, dj: usize| grid[(row + di) * side + col + dj];
+                let mut reach = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+                for tri in [[c(0, 0), c(0, 1), c(1, 1)], [c(0, 0), c(1, 1), c(1, 0)]] {
+                    // Barycentrics ≥ −s span the triangle scaled by 1 + 3s about its centroid.
+                    let centroid = (tri[0] + tri[1] + tri[2]) / 3.0;
+                    for v in tri {
+                        let p = centroid + (1.0 + 3.0 * SEED_SLACK) * (v - centroid);
+                        reach = (reach.0.min(p), reach.1.max(p));
+                    }
+                }
+                reach
+            }).collect();
+            for b in 0..blocks * blocks {
+                let (r0, c0) = ((b / blocks) * BLOCK, (b % blocks) * BLOCK);
+                let union = (r0..(r0 + BLOCK).min(n)).flat_map(|r| (c0..(c0 + BLOCK).min(n)).map(move |c| r * n + c)).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |u, q| (u.0.min(quads[q].0), u.1.max(quads[q].1)));
+                block_reach.push(union);
+            }
+            quad_reach.extend(quads);
+        }
+        Self { material, patches, seed_grid: n, seeds, quad_reach, block_reach }
     }
 
     pub fn len(&self) -> usize {
@@ -50,7 +84,9 @@ impl PatchSurfaces {
 
     /// Bytes held: control points and seed grids.
     pub fn memory_bytes(&self) -> usize {
-        self.patches.len() * std::mem::size_of::<BezierPatch>() + self.seeds.len() * std::mem::size_of::<DVec3>()
+        self.patches.len() * std::mem::size_of::<BezierPatch>()
+            + self.seeds.len() * std::mem::size_of::<DVec3>()
+            + (self.quad_reach.len() + self.block_reach.len()) * std::mem::size_of::<(DVec3, DVec3)>()
     }
 
     /// Surface data at `(u, v)` of patch `i`: the point and normal of the bicubic itself
@@ -78,9 +114,20 @@ impl PatchSurfaces {
         let side = n + 1;
         let grid = &self.seeds[i as usize * side * side..][..side * side];
         let tolerance = 1e-9 * patch.size();
+        let quad_reach = &self.quad_reach[i as usize * n * n..][..n * n];
+        let blocks = n.div_ceil(BLOCK);
+        let block_reach = &self.block_reach[i as usize * blocks * blocks..][..blocks * blocks];
+        let inv_d = d.recip();
         let mut best: Option<(f32, f32, f32)> = None;
-        for row in 0..n {
-            for col in 0..n {
+        for (b, reach) in block_reach.iter().enumerate() {
+            if !line_meets_box(o, inv_d, reach) {
+                continue;
+            }
+            let (r0, c0) = ((b / blocks) * BLOCK, (b % blocks) * BLOCK);
+            for (row, col) in (r0..(r0 + BLOCK).min(n)).flat_map(|r| (c0..(c0 + BLOCK).min(n)).map(move |c| (r, c))) {
+                if !line_meets_box(o, inv_d, &quad_reach[row * n + col]) {
+                    continue;
+                }
                 let corner = |di: usize, dj: usize| (grid[(row + di) * side + col + dj], DVec3::new((col + dj) as f64, (row + di) as f64, 0.0) / n as f64);
                 for [a, b, c] in [[corner(0, 0), corner(0, 1), corner(1, 1)], [corner(0, 0), corner(1, 1), corner(1, 0)]] {
                     let Some((t, b1, b2)) = plane_hit(o, d, [a.0, b.0, c.0]) else { continue };
@@ -95,6 +142,25 @@ impl PatchSurfaces {
         }
         best
     }
+}
+
+/// Whether the whole line `o + t·d` (any `t`: a seed behind the origin may still converge
+/// to a root in front) meets the box; `inv_d = 1/d` per component (±∞ for zero).
+fn line_meets_box(o: DVec3, inv_d: DVec3, (lo, hi): &(DVec3, DVec3)) -> bool {
+    let (mut near, mut far) = (f64::NEG_INFINITY, f64::INFINITY);
+    for k in 0..3 {
+        if inv_d[k].is_infinite() {
+            // Parallel to this slab: inside it or never.
+            if o[k] < lo[k] || o[k] > hi[k] {
+                return false;
+            }
+            continue;
+        }
+        let (t0, t1) = ((lo[k] - o[k]) * inv_d[k], (hi[k] - o[k]) * inv_d[k]);
+        near = near.max(t0.min(t1));
+        far = far.min(t0.max(t1));
+    }
+    near <= far
 }
 
 /// Where the ray meets the plane of `[a, b, c]`: `(t, b1, b2)`, if the barycentrics are
