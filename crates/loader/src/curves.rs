@@ -158,6 +158,11 @@ fn read_hair(path: &std::path::Path, bytes: &[u8]) -> Result<Vec<Strand>, LoadEr
     if !has_points {
         return Err(err("the file has no points array (flag bit 1)".into()));
     }
+    // Every strand has a point, and the points are bounded by the file's size below: so is
+    // anything sized by the strand count.
+    if strands > points {
+        return Err(err(format!("the header announces {strands} strands but only {points} points")));
+    }
     let size = 128 + [(has_segments, 2 * strands), (has_points, 12 * points), (has_thickness, 4 * points), (has_transparency, 4 * points), (has_color, 12 * points)].iter().filter(|(on, _)| *on).map(|(_, n)| n).sum::<usize>();
     if bytes.len() < size {
         return Err(err(format!("truncated: the header announces {size} bytes, the file has {}", bytes.len())));

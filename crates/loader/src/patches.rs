@@ -110,7 +110,8 @@ fn point(path: &Path, (line, text): (usize, &str), sep: char, field: &str) -> Re
 fn parse_newell(path: &Path, text: &str) -> Result<Vec<BezierPatch>, LoadError> {
     let mut lines = Lines::new(path, text);
     let patch_count = lines.count("patch count")?;
-    let mut patches = Vec::with_capacity(patch_count);
+    // No capacity from the header: a corrupt count must end in an error, not an allocation.
+    let mut patches = Vec::new();
     for k in 1..=patch_count {
         let field = format!("patch {k}");
         let (line, text) = lines.next(&field)?;
@@ -142,7 +143,8 @@ fn parse_newell(path: &Path, text: &str) -> Result<Vec<BezierPatch>, LoadError> 
 fn parse_bpt(path: &Path, text: &str) -> Result<Vec<BezierPatch>, LoadError> {
     let mut lines = Lines::new(path, text);
     let patch_count = lines.count("patch count")?;
-    let mut patches = Vec::with_capacity(patch_count);
+    // No capacity from the header: a corrupt count must end in an error, not an allocation.
+    let mut patches = Vec::new();
     for k in 1..=patch_count {
         let field = format!("patch {k}");
         let (line, text) = lines.next(&field)?;
@@ -213,6 +215,8 @@ mod tests {
         assert_eq!(newell_err(&newell(INDICES).replace("\n16\n", "\n17\n")), "t.txt: point 17: missing: the file ends early");
         assert_eq!(newell_err(&newell(INDICES).replace("\n16\n", "\n15\n")), "t.txt:19: unexpected line after the last point");
         assert_eq!(newell_err(&newell(INDICES).replacen("1\n", "2\n", 1)), "t.txt:3: patch 2: expected 16 comma-separated indices, found 1");
+        // A corrupt count is an error, not an allocation of that many patches.
+        assert_eq!(newell_err(&newell(INDICES).replacen("1\n", "99999999999999\n", 1)), "t.txt:3: patch 2: expected 16 comma-separated indices, found 1");
     }
 
     #[test]

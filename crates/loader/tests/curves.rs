@@ -130,6 +130,11 @@ fn hair_files_round_trip() {
     assert_eq!(load_in(&dir, &shape("file = \"d.hair\"\n")).unwrap_err(), format!("{}: not a .hair file (it does not start with \"HAIR\")", path("d.hair")));
     write_hair(&dir.join("e.hair"), &same, false, None, (2, 0.08));
     assert_eq!(load_in(&dir, &shape("file = \"e.hair\"\n")).unwrap_err(), format!("{}: the strands' segment counts make 6 points, the header says 8", path("e.hair")));
+    // Counts that the file cannot hold are errors before anything is allocated for them.
+    let mut huge = std::fs::read(dir.join("b.hair")).unwrap();
+    huge[4..8].copy_from_slice(&4_000_000_000u32.to_le_bytes());
+    std::fs::write(dir.join("g.hair"), huge).unwrap();
+    assert_eq!(load_in(&dir, &shape("file = \"g.hair\"\n")).unwrap_err(), format!("{}: the header announces 4000000000 strands but only 8 points", path("g.hair")));
     let mut truncated = std::fs::read(dir.join("a.hair")).unwrap();
     truncated.truncate(140);
     std::fs::write(dir.join("f.hair"), truncated).unwrap();
