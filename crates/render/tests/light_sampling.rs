@@ -23,7 +23,7 @@ fn bin(w: Vec3) -> usize {
 }
 
 /// χ² and degrees of freedom of `N` draws of `sample` (None: no direction) against
-/// `pdf` (solid-angle density), cells expecting fewer than 5 pooled.
+/// `pdf` (solid-angle density).
 fn chi_square(mut sample: impl FnMut(&mut Pcg32) -> Option<Vec3>, pdf: impl Fn(Vec3) -> f64) -> (f64, usize) {
     let mut observed = vec![0.0f64; NZ * NP + 1];
     let mut rng = Pcg32::new(17, 3);
@@ -46,27 +46,11 @@ fn chi_square(mut sample: impl FnMut(&mut Pcg32) -> Option<Vec3>, pdf: impl Fn(V
         .collect();
     let total: f64 = expected.iter().sum();
     expected.push((N as f64 - total).max(0.0));
-    let mut cells: Vec<(f64, f64)> = expected.into_iter().zip(observed).collect();
-    cells.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let (mut chi2, mut dof, mut pool) = (0.0, 0usize, (0.0, 0.0));
-    for (e, o) in cells {
-        if e < 5.0 {
-            pool = (pool.0 + e, pool.1 + o);
-            continue;
-        }
-        chi2 += (o - e) * (o - e) / e;
-        dof += 1;
-    }
-    if pool.0 > 0.0 {
-        chi2 += (pool.1 - pool.0) * (pool.1 - pool.0) / pool.0;
-        dof += 1;
-    }
-    (chi2, dof - 1)
+    raylab_testkit::chi_square(&expected, &observed)
 }
 
 fn assert_fits(name: &str, (chi2, dof): (f64, usize)) {
-    // Mean dof, standard deviation √(2 dof): five deviations up is p ≈ 1e-5.
-    let limit = dof as f64 + 5.0 * (2.0 * dof as f64).sqrt();
+    let limit = raylab_testkit::chi_square_limit(dof);
     assert!(dof >= 10, "{name}: only {dof} degrees of freedom");
     assert!(chi2 < limit, "{name}: χ² = {chi2:.1} with {dof} dof (limit {limit:.1})");
 }

@@ -149,3 +149,30 @@ pub fn read_obj_triangles(path: &std::path::Path) -> Soup {
     }
     Soup::triangles(tris)
 }
+
+/// Pearson's χ² of `observed` counts against `expected` ones (same cells), cells expecting
+/// fewer than 5 pooled into one: `(χ², degrees of freedom)`.
+pub fn chi_square(expected: &[f64], observed: &[f64]) -> (f64, usize) {
+    let mut cells: Vec<(f64, f64)> = expected.iter().copied().zip(observed.iter().copied()).collect();
+    cells.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (mut chi2, mut dof, mut pool) = (0.0, 0usize, (0.0, 0.0));
+    for (e, o) in cells {
+        if e < 5.0 {
+            pool = (pool.0 + e, pool.1 + o);
+            continue;
+        }
+        chi2 += (o - e) * (o - e) / e;
+        dof += 1;
+    }
+    if pool.0 > 0.0 {
+        chi2 += (pool.1 - pool.0) * (pool.1 - pool.0) / pool.0;
+        dof += 1;
+    }
+    (chi2, dof.saturating_sub(1))
+}
+
+/// The χ² a fit must stay under: the mean `dof` plus five standard deviations `√(2 dof)`
+/// (p ≈ 1e-5 of a false alarm).
+pub fn chi_square_limit(dof: usize) -> f64 {
+    dof as f64 + 5.0 * (2.0 * dof as f64).sqrt()
+}

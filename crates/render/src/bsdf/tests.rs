@@ -219,23 +219,7 @@ fn chi_square(b: &Bsdf, wo: Vec3, seed: u64) -> (f64, usize) {
         .collect();
     let total: f64 = expected.iter().sum();
     expected.push((n as f64 - total).max(0.0));
-    // Pool the cells expecting little, smallest first.
-    let mut cells: Vec<(f64, f64)> = expected.into_iter().zip(observed).collect();
-    cells.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let (mut chi2, mut dof, mut pool) = (0.0, 0usize, (0.0, 0.0));
-    for (e, o) in cells {
-        if e < 5.0 {
-            pool = (pool.0 + e, pool.1 + o);
-            continue;
-        }
-        chi2 += (o - e) * (o - e) / e;
-        dof += 1;
-    }
-    if pool.0 > 0.0 {
-        chi2 += (pool.1 - pool.0) * (pool.1 - pool.0) / pool.0;
-        dof += 1;
-    }
-    (chi2, dof - 1)
+    raylab_testkit::chi_square(&expected, &observed)
 }
 
 #[test]
@@ -249,8 +233,7 @@ fn sample_histogram_matches_pdf() {
     for (i, (name, b)) in models.iter().enumerate() {
         for (j, wo) in [dir(0.77, 0.5), dir(0.3, 4.0)].into_iter().enumerate() {
             let (chi2, dof) = chi_square(b, wo, (10 * i + j) as u64);
-            // Mean dof, standard deviation √(2 dof): five deviations up is p ≈ 1e-5.
-            let limit = dof as f64 + 5.0 * (2.0 * dof as f64).sqrt();
+            let limit = raylab_testkit::chi_square_limit(dof);
             assert!(chi2 < limit, "{name} wo={wo}: χ² = {chi2:.1} with {dof} dof (limit {limit:.1})");
         }
     }
