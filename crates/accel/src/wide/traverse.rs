@@ -13,6 +13,16 @@ use raylab_core::intersect::ShearedRay;
 use raylab_core::Ray;
 
 use super::kernels::{boxes_portable, triangle_candidates, RayBoxes, ROBUST_FAR};
+
+/// The triangle filter of the kernel in use (SSE2 on x86-64 for both SIMD widths).
+#[inline(always)]
+fn candidates<const SIMD: bool>(b: &TriBlock, s: &ShearedRay) -> u32 {
+    #[cfg(target_arch = "x86_64")]
+    if SIMD {
+        return super::kernels::triangle_candidates_sse(b, s);
+    }
+    triangle_candidates(b, s)
+}
 use super::node::{is_leaf, leaf_blocks, ChildRef, TriBlock, WideNode, EMPTY};
 use super::WideBvh;
 use crate::{Counters, Hit, PrimHit, Primitives};
@@ -55,9 +65,9 @@ fn child_boxes<const W: usize, const SIMD: bool>(node: &WideNode<W>, r: &RayBoxe
 
 /// Closest hit among the blocks of a leaf; moves `ray.t_max` to each hit found.
 #[inline(always)]
-fn leaf_closest<P: Primitives + ?Sized, const COUNT: bool>(blocks: &[TriBlock], prims: &P, s: &ShearedRay, ray: &mut Ray, best: &mut Option<Hit>, w: &mut Work) {
+fn leaf_closest<P: Primitives + ?Sized, const SIMD: bool, const COUNT: bool>(blocks: &[TriBlock], prims: &P, s: &ShearedRay, ray: &mut Ray, best: &mut Option<Hit>, w: &mut Work) {
     for b in blocks {
-        let mut m = triangle_candidates(b, s);
+        let mut m = candidates::<SIMD>(b, s);
         if COUNT {
             w.tests += b.prim.iter().filter(|&&p| p != EMPTY).count() as u64;
         }
@@ -80,9 +90,9 @@ fn leaf_closest<P: Primitives + ?Sized, const COUNT: bool>(blocks: &[TriBlock], 
 
 /// Whether anything in the blocks of a leaf is hit; stops at the first.
 #[inline(always)]
-fn leaf_any<P: Primitives + ?Sized, const COUNT: bool>(blocks: &[TriBlock], prims: &P, s: &ShearedRay, ray: &Ray, w: &mut Work) -> bool {
+fn leaf_any<P: Primitives + ?Sized, const SIMD: bool, const COUNT: bool>(blocks: &[TriBlock], prims: &P, s: &ShearedRay, ray: &Ray, w: &mut Work) -> bool {
     for b in blocks {
-        let mut m = triangle_candidates(b, s);
+        let mut m = candidates::<SIMD>(b, s);
         if COUNT {
             w.tests += b.prim.iter().filter(|&&p| p != EMPTY).count() as u64;
         }
@@ -130,7 +140,7 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, const SIMD: bool, 
             w.nodes += 1;
         }
         if is_leaf(cur) {
-            leaf_closest::<P, COUNT>(leaf_slice(bvh, cur), prims, &s, &mut ray, &mut best, &mut w);
+            leaf_closest::<P, SIMD, COUNT>(leaf_slice(bvh, cur), prims, &s, &mut ray, &mut best, &mut w);
         } else {
             let node = &bvh.nodes[cur as usize];
             let mut tnear = [0.0f32; W];
@@ -207,7 +217,7 @@ pub(super) fn any<P: Primitives + ?Sized, const W: usize, const SIMD: bool, cons
             w.nodes += 1;
         }
         if is_leaf(cur) {
-            if leaf_any::<P, COUNT>(leaf_slice(bvh, cur), prims, &s, ray, &mut w) {
+            if leaf_any::<P, SIMD, COUNT>(leaf_slice(bvh, cur), prims, &s, ray, &mut w) {
                 hit = true;
                 break;
             }
