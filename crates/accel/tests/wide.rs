@@ -103,3 +103,25 @@ fn watertight_from_inside_the_cube() {
         }
     }
 }
+
+/// A binary leaf too large for one leaf reference (more than 16 blocks) is spread over a
+/// wide node of smaller leaves, and still answers as the oracle does.
+#[test]
+fn oversized_binary_leaf_is_split() {
+    use raylab_accel::bvh::{Bvh, BvhNode};
+    use raylab_accel::WideBvh;
+    let mut rng = Pcg32::new(24, 1);
+    let unit = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
+    let soup = kit::random_triangles(&mut rng, 300, &unit, 0.2);
+    let bin = Bvh::from_parts(vec![BvhNode::leaf(soup.bounds(), 0, 300)], (0..300).collect(), 300, "one leaf");
+    let oracle = AnyAccel::build(AccelKind::None, &soup, &BuildOptions::default());
+    for kernel in [Kernel::Simd, Kernel::Portable] {
+        let wide = WideBvh::<8>::from_binary(&bin, &soup, "bvh8").with_kernel(kernel);
+        wide.validate(&soup).unwrap();
+        assert!(!wide.nodes.is_empty(), "the leaf was not split");
+        let mut c = Counters::default();
+        for ray in kit::random_rays(&mut rng, 500, &unit, &unit) {
+            assert_eq!(wide.intersect(&soup, &ray, &mut c).map(|h| h.t), oracle.intersect(&soup, &ray, &mut c).map(|h| h.t));
+        }
+    }
+}
