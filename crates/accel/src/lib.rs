@@ -18,6 +18,7 @@ mod leaf;
 pub mod primitives;
 pub mod sphere_bvh;
 pub mod stats;
+pub mod wide;
 
 use std::fmt;
 use std::str::FromStr;
@@ -34,6 +35,7 @@ pub use kdtree::KdTree;
 pub use primitives::{Hit, PrimHit, Primitives};
 pub use sphere_bvh::SphereBvh;
 pub use stats::AccelStats;
+pub use wide::{Kernel, WideBvh};
 
 /// What every acceleration structure offers.
 pub trait Accel: Send + Sync {
@@ -87,11 +89,17 @@ pub enum AccelKind {
     SphereBvh,
     /// BVH with spatial splits (Stich et al. 2009).
     Sbvh,
+    /// Binned SAH BVH collapsed to 8-wide SIMD nodes with 4-triangle leaf blocks.
+    Bvh8,
+    /// Binned SAH BVH collapsed to 4-wide SIMD nodes with 4-triangle leaf blocks.
+    Bvh4,
+    /// SBVH collapsed to 8-wide nodes.
+    Bvh8Sbvh,
 }
 
 impl AccelKind {
     pub const ALL: &'static [AccelKind] =
-        &[AccelKind::None, AccelKind::Bvh, AccelKind::BvhMedian, AccelKind::BvhMidpoint, AccelKind::Aabb, AccelKind::Grid, AccelKind::Lbvh, AccelKind::LbvhPloc, AccelKind::KdTree, AccelKind::SphereBvh, AccelKind::Sbvh];
+        &[AccelKind::None, AccelKind::Bvh, AccelKind::BvhMedian, AccelKind::BvhMidpoint, AccelKind::Aabb, AccelKind::Grid, AccelKind::Lbvh, AccelKind::LbvhPloc, AccelKind::KdTree, AccelKind::SphereBvh, AccelKind::Sbvh, AccelKind::Bvh8, AccelKind::Bvh4, AccelKind::Bvh8Sbvh];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -106,6 +114,9 @@ impl AccelKind {
             AccelKind::KdTree => "kdtree",
             AccelKind::SphereBvh => "sphere-bvh",
             AccelKind::Sbvh => "sbvh",
+            AccelKind::Bvh8 => "bvh8",
+            AccelKind::Bvh4 => "bvh4",
+            AccelKind::Bvh8Sbvh => "bvh8-sbvh",
         }
     }
 
@@ -189,6 +200,8 @@ pub enum AnyAccel {
     Grid(Grid),
     KdTree(KdTree),
     SphereBvh(SphereBvh),
+    Bvh8(WideBvh<8>),
+    Bvh4(WideBvh<4>),
 }
 
 macro_rules! dispatch {
@@ -200,6 +213,8 @@ macro_rules! dispatch {
             AnyAccel::Grid($a) => $e,
             AnyAccel::KdTree($a) => $e,
             AnyAccel::SphereBvh($a) => $e,
+            AnyAccel::Bvh8($a) => $e,
+            AnyAccel::Bvh4($a) => $e,
         }
     };
 }
@@ -220,10 +235,44 @@ impl AnyAccel {
             AccelKind::KdTree => AnyAccel::KdTree(KdTree::build(prims, opts)),
             AccelKind::SphereBvh => AnyAccel::SphereBvh(SphereBvh::build(prims, opts)),
             AccelKind::Sbvh => AnyAccel::Bvh(bvh::sbvh::build(prims, opts)),
+            AccelKind::Bvh8 => AnyAccel::Bvh8(WideBvh::from_binary(&Bvh::build(prims, SplitMethod::BinnedSah, opts), prims, "bvh8")),
+            AccelKind::Bvh4 => AnyAccel::Bvh4(WideBvh::from_binary(&Bvh::build(prims, SplitMethod::BinnedSah, opts), prims, "bvh4")),
+            AccelKind::Bvh8Sbvh => AnyAccel::Bvh8(WideBvh::from_binary(&bvh::sbvh::build(prims, opts), prims, "bvh8-sbvh")),
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
         dispatch!(&mut accel, a => a.build_ms = ms);
         accel
+    }
+
+    /// [`Accel::intersect`] without counters: wide BVHs run their non-counting build (the
+    /// counters compiled out), other structures count into a scratch value.
+    #[inline]
+    pub fn intersect_fast<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray) -> Option<Hit> {
+        match self {
+            AnyAccel::Bvh8(a) => a.intersect_fast(prims, ray),
+            AnyAccel::Bvh4(a) => a.intersect_fast(prims, ray),
+            a => a.intersect(prims, ray, &mut Counters::default()),
+        }
+    }
+
+    /// [`Accel::occluded`] without counters (see [`AnyAccel::intersect_fast`]).
+    #[inline]
+    pub fn occluded_fast<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray) -> bool {
+        match self {
+            AnyAccel::Bvh8(a) => a.occluded_fast(prims, ray),
+            AnyAccel::Bvh4(a) => a.occluded_fast(prims, ray),
+            a => a.occluded(prims, ray, &mut Counters::default()),
+        }
+    }
+
+    /// Forces the kernel of a wide BVH (no effect on other structures): tests compare the
+    /// SIMD and portable kernels.
+    pub fn with_kernel(self, k: Kernel) -> Self {
+        match self {
+            AnyAccel::Bvh8(a) => AnyAccel::Bvh8(a.with_kernel(k)),
+            AnyAccel::Bvh4(a) => AnyAccel::Bvh4(a.with_kernel(k)),
+            a => a,
+        }
     }
 }
 

@@ -45,6 +45,15 @@ pub trait Primitives: Sync {
     /// Hit with `t` in `(ray.t_min, ray.t_max]`, or `None`.
     fn intersect(&self, i: u32, ray: &Ray) -> Option<PrimHit>;
 
+    /// The vertices of primitive `i` when it is a triangle whose [`Primitives::intersect`]
+    /// is exactly `raylab_core::intersect::triangle(ray, p0, p1, p2)` (same `t`, same
+    /// barycentrics as `u`, `v`); `None` otherwise (the default). Wide BVHs copy such
+    /// triangles into their leaves and test them without calling `intersect`; every other
+    /// primitive still goes through `intersect`.
+    fn triangle(&self, _i: u32) -> Option<[Vec3; 3]> {
+        None
+    }
+
     /// Bounds of the part of primitive `i` that lies inside `clip`, for spatial splits
     /// (kd-tree "perfect splits", SBVH). The default, `bounds ∩ clip`, is conservative;
     /// triangles override it with exact polygon clipping.

@@ -106,7 +106,7 @@ fn bad_input_fails_with_file_line_and_field() {
     fails_with(
         &["render", "--accel", "octree"],
         &dir,
-        "--accel: unknown acceleration structure `octree` (valid: none, bvh, bvh-median, bvh-midpoint, aabb, grid, lbvh, lbvh-ploc, kdtree, sphere-bvh, sbvh)",
+        "--accel: unknown acceleration structure `octree` (valid: none, bvh, bvh-median, bvh-midpoint, aabb, grid, lbvh, lbvh-ploc, kdtree, sphere-bvh, sbvh, bvh8, bvh4, bvh8-sbvh)",
     );
     fails_with(&["trace", "radius.toml", "--rays", "absent.rays"], &dir, "absent.rays: cannot open: No such file or directory (os error 2)");
     assert!(!dir.join("raylab.png").exists(), "a failed render must not write an image");
@@ -121,7 +121,7 @@ fn bench_agrees_with_the_oracle_and_trace_reproduces_it() {
     let json: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("b.json")).unwrap()).unwrap();
     let results = json["results"].as_array().unwrap();
     let accels: Vec<&str> = results.iter().map(|r| r["accel"].as_str().unwrap()).collect();
-    assert_eq!(accels, ["none", "bvh", "bvh-median", "bvh-midpoint", "aabb", "grid", "lbvh", "lbvh-ploc", "kdtree", "sphere-bvh", "sbvh"]);
+    assert_eq!(accels, ["none", "bvh", "bvh-median", "bvh-midpoint", "aabb", "grid", "lbvh", "lbvh-ploc", "kdtree", "sphere-bvh", "sbvh", "bvh8", "bvh4", "bvh8-sbvh"]);
     let oracle = &results[0]["rays"]["primary"];
     for r in results {
         assert_eq!(r["rays"]["primary"]["hits"], oracle["hits"], "{}", r["accel"]);

@@ -15,67 +15,105 @@ use crate::{gamma, Ray};
 /// (the weight of `p0` is `1 - b1 - b2`), for `t` in `(ray.t_min, ray.t_max]`.
 #[inline]
 pub fn triangle(ray: &Ray, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<(f32, f32, f32)> {
-    let d = ray.dir;
-    let ad = d.abs();
-    let kz = if ad.x > ad.y { if ad.x > ad.z { 0 } else { 2 } } else if ad.y > ad.z { 1 } else { 2 };
-    let mut kx = (kz + 1) % 3;
-    let mut ky = (kx + 1) % 3;
-    if d[kz] < 0.0 {
-        std::mem::swap(&mut kx, &mut ky);
+    ShearedRay::new(ray).triangle(ray.t_min, ray.t_max, p0, p1, p2)
+}
+
+/// The per-ray part of [`triangle`]: the axis permutation and shear constants (three
+/// divisions) that depend only on the direction. Structures that test many triangles
+/// against one ray compute it once; [`ShearedRay::triangle`] then does exactly the
+/// arithmetic of [`triangle`], so both give bit-identical answers.
+#[derive(Clone, Copy, Debug)]
+pub struct ShearedRay {
+    pub origin: Vec3,
+    /// Axis the ray mostly runs along (`kz`), and the two others in an order that keeps
+    /// the winding (`kx`, `ky`).
+    pub kx: usize,
+    pub ky: usize,
+    pub kz: usize,
+    /// Shear `d[kx]/d[kz]`, `d[ky]/d[kz]` and scale `1/d[kz]`.
+    pub sx: f32,
+    pub sy: f32,
+    pub sz: f32,
+}
+
+impl ShearedRay {
+    #[inline]
+    pub fn new(ray: &Ray) -> Self {
+        let d = ray.dir;
+        let ad = d.abs();
+        let kz = if ad.x > ad.y { if ad.x > ad.z { 0 } else { 2 } } else if ad.y > ad.z { 1 } else { 2 };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        Self { origin: ray.origin, kx, ky, kz, sx: d[kx] / d[kz], sy: d[ky] / d[kz], sz: 1.0 / d[kz] }
     }
-    let sx = d[kx] / d[kz];
-    let sy = d[ky] / d[kz];
-    let sz = 1.0 / d[kz];
-    let a = p0 - ray.origin;
-    let b = p1 - ray.origin;
-    let c = p2 - ray.origin;
-    let ax = a[kx] - sx * a[kz];
-    let ay = a[ky] - sy * a[kz];
-    let bx = b[kx] - sx * b[kz];
-    let by = b[ky] - sy * b[kz];
-    let cx = c[kx] - sx * c[kz];
-    let cy = c[ky] - sy * c[kz];
-    let mut u = cx * by - cy * bx;
-    let mut v = ax * cy - ay * cx;
-    let mut w = bx * ay - by * ax;
-    if u == 0.0 || v == 0.0 || w == 0.0 {
-        let (ax, ay, bx, by, cx, cy) = (ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64);
-        u = (cx * by - cy * bx) as f32;
-        v = (ax * cy - ay * cx) as f32;
-        w = (bx * ay - by * ax) as f32;
+
+    /// The sheared 2D coordinates `(x, y)` of vertex `p` (before the double-precision
+    /// fallback): what [`ShearedRay::triangle`] computes first, exposed so that SIMD
+    /// filters can reproduce it lane by lane.
+    #[inline]
+    pub fn project(&self, p: Vec3) -> (f32, f32) {
+        let a = p - self.origin;
+        (a[self.kx] - self.sx * a[self.kz], a[self.ky] - self.sy * a[self.kz])
     }
-    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
-        return None;
+
+    /// [`triangle`] for this ray over `(t_min, t_max]`.
+    #[inline]
+    pub fn triangle(&self, t_min: f32, t_max: f32, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<(f32, f32, f32)> {
+        let (kx, ky, kz, sx, sy, sz) = (self.kx, self.ky, self.kz, self.sx, self.sy, self.sz);
+        let a = p0 - self.origin;
+        let b = p1 - self.origin;
+        let c = p2 - self.origin;
+        let ax = a[kx] - sx * a[kz];
+        let ay = a[ky] - sy * a[kz];
+        let bx = b[kx] - sx * b[kz];
+        let by = b[ky] - sy * b[kz];
+        let cx = c[kx] - sx * c[kz];
+        let cy = c[ky] - sy * c[kz];
+        let mut u = cx * by - cy * bx;
+        let mut v = ax * cy - ay * cx;
+        let mut w = bx * ay - by * ax;
+        if u == 0.0 || v == 0.0 || w == 0.0 {
+            let (ax, ay, bx, by, cx, cy) = (ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64);
+            u = (cx * by - cy * bx) as f32;
+            v = (ax * cy - ay * cx) as f32;
+            w = (bx * ay - by * ax) as f32;
+        }
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return None;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            return None;
+        }
+        let az = sz * a[kz];
+        let bz = sz * b[kz];
+        let cz = sz * c[kz];
+        let t_scaled = u * az + v * bz + w * cz;
+        let inv_det = 1.0 / det;
+        let t = t_scaled * inv_det;
+        if !(t > t_min && t <= t_max) {
+            return None;
+        }
+        // A hit this close to the origin may be rounding error of a ray leaving this very
+        // triangle: reject t below its error bound (pbrt-v4 §6.8.4), which is what makes the
+        // tiny offsets of `offset_ray_origin` safe.
+        let max_zt = az.abs().max(bz.abs()).max(cz.abs());
+        let max_xt = ax.abs().max(bx.abs()).max(cx.abs());
+        let max_yt = ay.abs().max(by.abs()).max(cy.abs());
+        let delta_z = gamma(3) * max_zt;
+        let delta_x = gamma(5) * (max_xt + max_zt);
+        let delta_y = gamma(5) * (max_yt + max_zt);
+        let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+        let max_e = u.abs().max(v.abs()).max(w.abs());
+        let delta_t = 3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+        if t <= delta_t {
+            return None;
+        }
+        Some((t, v * inv_det, w * inv_det))
     }
-    let det = u + v + w;
-    if det == 0.0 {
-        return None;
-    }
-    let az = sz * a[kz];
-    let bz = sz * b[kz];
-    let cz = sz * c[kz];
-    let t_scaled = u * az + v * bz + w * cz;
-    let inv_det = 1.0 / det;
-    let t = t_scaled * inv_det;
-    if !(t > ray.t_min && t <= ray.t_max) {
-        return None;
-    }
-    // A hit this close to the origin may be rounding error of a ray leaving this very
-    // triangle: reject t below its error bound (pbrt-v4 §6.8.4), which is what makes the
-    // tiny offsets of `offset_ray_origin` safe.
-    let max_zt = az.abs().max(bz.abs()).max(cz.abs());
-    let max_xt = ax.abs().max(bx.abs()).max(cx.abs());
-    let max_yt = ay.abs().max(by.abs()).max(cy.abs());
-    let delta_z = gamma(3) * max_zt;
-    let delta_x = gamma(5) * (max_xt + max_zt);
-    let delta_y = gamma(5) * (max_yt + max_zt);
-    let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-    let max_e = u.abs().max(v.abs()).max(w.abs());
-    let delta_t = 3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
-    if t <= delta_t {
-        return None;
-    }
-    Some((t, v * inv_det, w * inv_det))
 }
 
 /// Ray–sphere intersection, nearest root in `(ray.t_min, ray.t_max]`.

@@ -45,7 +45,7 @@ pub struct RenderSettings {
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { width: 640, height: 480, spp: 4, sampler: SamplerKind::Jittered, max_depth: 8, integrator: IntegratorKind::Whitted, light_sampling: LightSampling::Mis, mis_heuristic: MisHeuristic::Power, light_cells: crate::light::DEFAULT_CELLS, accel: AccelKind::Bvh, seed: 0, filter: PixelFilter::Box }
+        Self { width: 640, height: 480, spp: 4, sampler: SamplerKind::Jittered, max_depth: 8, integrator: IntegratorKind::Whitted, light_sampling: LightSampling::Mis, mis_heuristic: MisHeuristic::Power, light_cells: crate::light::DEFAULT_CELLS, accel: AccelKind::Bvh8, seed: 0, filter: PixelFilter::Box }
     }
 }
 

@@ -66,6 +66,13 @@ impl Primitives for Soup {
         }
     }
 
+    fn triangle(&self, i: u32) -> Option<[Vec3; 3]> {
+        match self.prims[i as usize] {
+            Prim::Triangle(v) => Some(v),
+            Prim::Sphere { .. } => None,
+        }
+    }
+
     fn objects(&self) -> Vec<Range<u32>> {
         self.objects.clone()
     }

@@ -53,7 +53,7 @@ pub struct Bvh {
     primitives: usize,
     /// Leaves may hold clipped references (SBVH): a primitive may stick out of its leaf's
     /// box, as long as the parts in all its leaves cover it.
-    spatial_splits: bool,
+    pub(crate) spatial_splits: bool,
 }
 
 /// Trees deeper than this are cut into leaves: bounds the traversal stack.

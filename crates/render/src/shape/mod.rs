@@ -220,6 +220,14 @@ impl Primitives for Geometry {
         }
     }
 
+    /// Mesh triangles, whose `intersect` is `intersect::triangle` on these vertices.
+    fn triangle(&self, i: u32) -> Option<[Vec3; 3]> {
+        match self.prims[i as usize] {
+            PrimRef::Triangle { mesh, tri } => Some(self.meshes[mesh as usize].vertices(tri)),
+            PrimRef::Sphere(_) | PrimRef::Curve { .. } | PrimRef::Patch { .. } => None,
+        }
+    }
+
     fn objects(&self) -> Vec<Range<u32>> {
         self.objects.clone()
     }

@@ -1,0 +1,301 @@
+//! The per-node and per-leaf kernels: a slab test of all `W` child boxes at once, and a
+//! watertight test of a block of four triangles with the ray's shear computed once.
+//!
+//! Each kernel has a portable form and a SIMD form (`std::arch`: AVX2 for 8 lanes, SSE2
+//! for 4) doing the same IEEE operations in the same order — no FMA, whose single rounding
+//! would change results — so both give bit-identical answers; the tests compare them.
+
+use raylab_core::intersect::ShearedRay;
+use raylab_core::{gamma, Ray};
+
+use super::node::{TriBlock, WideNode, EMPTY};
+
+/// Far distances are scaled by `1 + 2γ₃` so that rounding never misses a box (pbrt-v4
+/// §6.8.2), as `Aabb::intersect` does.
+pub const ROBUST_FAR: f32 = 1.0 + 2.0 * gamma(3);
+
+/// Per-ray constants of the slab test.
+///
+/// The slab distances are computed as `(bound - origin) * inv_dir`, exactly as
+/// `Aabb::intersect` does, not as `bound * inv_dir - origin * inv_dir` with the product
+/// precomputed: that form (one FMA per slab in Embree) cancels catastrophically near the
+/// origin, where rays leaving a surface need the box test most, and with a zero direction
+/// component it computes `∞ - ∞`. One subtraction more per slab keeps pbrt's error bound.
+#[derive(Clone, Copy, Debug)]
+pub struct RayBoxes {
+    pub origin: [f32; 3],
+    pub inv: [f32; 3],
+    /// Row of [`WideNode::bounds`] giving the near (entry) plane of each axis: the min row
+    /// when the direction is positive, the max row when it is negative. This sorts the
+    /// slab distances once per ray instead of once per box.
+    pub near: [usize; 3],
+    pub far: [usize; 3],
+    pub t_min: f32,
+}
+
+impl RayBoxes {
+    #[inline]
+    pub fn new(ray: &Ray) -> Self {
+        let inv = ray.inv_dir().to_array();
+        let near = [0, 1, 2].map(|a| if inv[a] < 0.0 { 3 + a } else { a });
+        let far = [0, 1, 2].map(|a| if inv[a] < 0.0 { a } else { 3 + a });
+        Self { origin: ray.origin.to_array(), inv, near, far, t_min: ray.t_min }
+    }
+}
+
+/// Which children of `node` the ray enters within `[t_min, t_max]` (bit `l` for lane `l`)
+/// and their entry distances. Callers pass `t_max` already widened by [`ROBUST_FAR`]:
+/// the entry distance of a flat box (coplanar triangles) may round a few ulps above the
+/// distance the triangle kernel computes for a hit inside it, and such a box must not be
+/// culled by that hit. A NaN slab distance (a ray lying in a slab's plane)
+/// constrains nothing, as in `Aabb::intersect`.
+#[inline(always)]
+pub fn boxes_portable<const W: usize>(node: &WideNode<W>, r: &RayBoxes, t_max: f32, tnear: &mut [f32; W]) -> u32 {
+    let mut mask = 0;
+    for lane in 0..W {
+        let (mut t0, mut t1) = (r.t_min, t_max);
+        for a in 0..3 {
+            let near = (node.bounds[r.near[a]][lane] - r.origin[a]) * r.inv[a];
+            let far = (node.bounds[r.far[a]][lane] - r.origin[a]) * r.inv[a] * ROBUST_FAR;
+            // Written as the SIMD max/min instructions behave: `max(a, b) = a > b ? a : b`.
+            t0 = if near > t0 { near } else { t0 };
+            t1 = if far < t1 { far } else { t1 };
+        }
+        tnear[lane] = t0;
+        mask |= u32::from(t0 <= t1) << lane;
+    }
+    mask
+}
+
+/// [`boxes_portable`] for eight lanes with AVX.
+///
+/// # Safety
+/// The CPU must support AVX2 (checked by `is_x86_feature_detected!` at build).
+#[cfg(target_arch = "x86_64")]
+#[inline]
+#[target_feature(enable = "avx2")]
+pub unsafe fn boxes_avx2(node: &WideNode<8>, r: &RayBoxes, t_max: f32, tnear: &mut [f32; 8]) -> u32 {
+    use std::arch::x86_64::*;
+    let mut t0 = _mm256_set1_ps(r.t_min);
+    let mut t1 = _mm256_set1_ps(t_max);
+    for a in 0..3 {
+        let o = _mm256_set1_ps(r.origin[a]);
+        let inv = _mm256_set1_ps(r.inv[a]);
+        // SAFETY: each row holds 8 f32.
+        let (lo, hi) = unsafe { (_mm256_loadu_ps(node.bounds[r.near[a]].as_ptr()), _mm256_loadu_ps(node.bounds[r.far[a]].as_ptr())) };
+        let near = _mm256_mul_ps(_mm256_sub_ps(lo, o), inv);
+        let far = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(hi, o), inv), _mm256_set1_ps(ROBUST_FAR));
+        // `max_ps(a, b)` returns `b` when either is NaN: a NaN slab is ignored.
+        t0 = _mm256_max_ps(near, t0);
+        t1 = _mm256_min_ps(far, t1);
+    }
+    // SAFETY: `tnear` holds 8 f32.
+    unsafe { _mm256_storeu_ps(tnear.as_mut_ptr(), t0) };
+    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32
+}
+
+/// [`boxes_portable`] for four lanes with SSE2 (part of every x86-64 CPU).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub fn boxes_sse(node: &WideNode<4>, r: &RayBoxes, t_max: f32, tnear: &mut [f32; 4]) -> u32 {
+    use std::arch::x86_64::*;
+    // SAFETY: SSE2 is in the x86-64 baseline; the loads read 4 f32 of each row.
+    unsafe {
+        let mut t0 = _mm_set1_ps(r.t_min);
+        let mut t1 = _mm_set1_ps(t_max);
+        for a in 0..3 {
+            let o = _mm_set1_ps(r.origin[a]);
+            let inv = _mm_set1_ps(r.inv[a]);
+            let near = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(node.bounds[r.near[a]].as_ptr()), o), inv);
+            let far = _mm_mul_ps(_mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(node.bounds[r.far[a]].as_ptr()), o), inv), _mm_set1_ps(ROBUST_FAR));
+            t0 = _mm_max_ps(near, t0);
+            t1 = _mm_min_ps(far, t1);
+        }
+        _mm_storeu_ps(tnear.as_mut_ptr(), t0);
+        _mm_movemask_ps(_mm_cmple_ps(t0, t1)) as u32
+    }
+}
+
+/// Lanes of `b` that may be hit: every lane except those whose three single-precision
+/// edge functions are all non-zero with mixed signs, which [`ShearedRay::triangle`] rejects
+/// too (it recomputes in double precision only when one of them is exactly zero). Lanes
+/// that are not triangles ([`TriBlock::OTHER`]) are always candidates; empty lanes never.
+/// The candidates then go through the exact scalar kernel, so the filter cannot change an
+/// answer, only skip work.
+#[inline(always)]
+pub fn triangle_candidates(b: &TriBlock, s: &ShearedRay) -> u32 {
+    let (kx, ky, kz) = (s.kx, s.ky, s.kz);
+    let o = s.origin.to_array();
+    let mut xs = [[0.0f32; 4]; 3];
+    let mut ys = [[0.0f32; 4]; 3];
+    for v in 0..3 {
+        for l in 0..4 {
+            let az = b.p[v][kz][l] - o[kz];
+            xs[v][l] = (b.p[v][kx][l] - o[kx]) - s.sx * az;
+            ys[v][l] = (b.p[v][ky][l] - o[ky]) - s.sy * az;
+        }
+    }
+    let mut mask = 0u32;
+    for l in 0..4 {
+        let (ax, ay, bx, by, cx, cy) = (xs[0][l], ys[0][l], xs[1][l], ys[1][l], xs[2][l], ys[2][l]);
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        let rejected = (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) && u != 0.0 && v != 0.0 && w != 0.0;
+        let prim = b.prim[l];
+        let keep = prim != EMPTY && (prim & TriBlock::OTHER != 0 || !rejected);
+        mask |= u32::from(keep) << l;
+    }
+    mask
+}
+
+/// [`triangle_candidates`] with SSE2 (part of every x86-64 CPU): the same operations on
+/// four lanes at once, so the same mask.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub fn triangle_candidates_sse(b: &TriBlock, s: &ShearedRay) -> u32 {
+    use std::arch::x86_64::*;
+    let (kx, ky, kz) = (s.kx, s.ky, s.kz);
+    // SAFETY: SSE2 is in the x86-64 baseline; every row holds 4 f32.
+    let rejected = unsafe {
+        let (ox, oy, oz) = (_mm_set1_ps(s.origin[kx]), _mm_set1_ps(s.origin[ky]), _mm_set1_ps(s.origin[kz]));
+        let (sx, sy) = (_mm_set1_ps(s.sx), _mm_set1_ps(s.sy));
+        let project = |v: usize| {
+            let az = _mm_sub_ps(_mm_loadu_ps(b.p[v][kz].as_ptr()), oz);
+            let x = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(b.p[v][kx].as_ptr()), ox), _mm_mul_ps(sx, az));
+            let y = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(b.p[v][ky].as_ptr()), oy), _mm_mul_ps(sy, az));
+            (x, y)
+        };
+        let ((ax, ay), (bx, by), (cx, cy)) = (project(0), project(1), project(2));
+        let u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
+        let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
+        let w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
+        let zero = _mm_setzero_ps();
+        let neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)), _mm_cmplt_ps(w, zero));
+        let pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)), _mm_cmpgt_ps(w, zero));
+        // `cmpneq` is true for NaN, as `!=` is.
+        let nonzero = _mm_and_ps(_mm_and_ps(_mm_cmpneq_ps(u, zero), _mm_cmpneq_ps(v, zero)), _mm_cmpneq_ps(w, zero));
+        _mm_movemask_ps(_mm_and_ps(_mm_and_ps(neg, pos), nonzero)) as u32
+    };
+    let mut keep = 0u32;
+    for l in 0..4 {
+        let prim = b.prim[l];
+        let k = prim != EMPTY && (prim & TriBlock::OTHER != 0 || rejected & (1 << l) == 0);
+        keep |= u32::from(k) << l;
+    }
+    keep
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wide::node::WideNode;
+    use raylab_core::{Aabb, Vec3};
+
+    fn node8() -> WideNode<8> {
+        let mut n = WideNode::<8>::EMPTY_NODE;
+        n.set(0, &Aabb::new(Vec3::ZERO, Vec3::ONE), 10);
+        // The ray below lies in this box's y = 0.5 face plane: a NaN slab, ignored.
+        n.set(2, &Aabb::new(Vec3::new(2.0, 0.5, 0.0), Vec3::new(3.0, 0.7, 1.0)), 12);
+        // Behind the origin.
+        n.set(3, &Aabb::new(Vec3::new(-3.0, 0.0, 0.0), Vec3::new(-2.0, 1.0, 1.0)), 13);
+        // Beyond t_max = 10.
+        n.set(5, &Aabb::new(Vec3::new(20.0, 0.0, 0.0), Vec3::new(21.0, 1.0, 1.0)), 15);
+        n
+    }
+
+    #[test]
+    fn hand_computed_slab_tests() {
+        let ray = Ray::segment(Vec3::new(-1.0, 0.5, 0.5), Vec3::X, 0.0, 10.0);
+        let r = RayBoxes::new(&ray);
+        let n = node8();
+        let mut t = [0.0; 8];
+        // Lanes 0 (entry at x = 0: t = 1) and 2 (entry at x = 2: t = 3); the empty slots,
+        // the box behind and the one beyond t_max are missed.
+        assert_eq!(boxes_portable(&n, &r, ray.t_max, &mut t), 0b101);
+        assert_eq!((t[0], t[2]), (1.0, 3.0));
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            let mut t8 = [0.0; 8];
+            // SAFETY: AVX2 detected.
+            assert_eq!(unsafe { boxes_avx2(&n, &r, ray.t_max, &mut t8) }, 0b101);
+            assert_eq!(t8.map(f32::to_bits), t.map(f32::to_bits), "identical entry distances");
+        }
+        // Reversed direction: only the box behind, entered at t = 1 (x = -2).
+        let back = Ray::segment(Vec3::new(-1.0, 0.5, 0.5), -Vec3::X, 0.0, 10.0);
+        assert_eq!(boxes_portable(&n, &RayBoxes::new(&back), back.t_max, &mut t), 0b1000);
+        assert_eq!(t[3], 1.0);
+    }
+
+    #[test]
+    fn four_wide_sse_matches_portable() {
+        let mut n = WideNode::<4>::EMPTY_NODE;
+        n.set(0, &Aabb::new(Vec3::ZERO, Vec3::ONE), 1);
+        n.set(1, &Aabb::new(Vec3::new(0.0, 2.0, 0.0), Vec3::new(1.0, 3.0, 1.0)), 2);
+        let ray = Ray::new(Vec3::new(0.5, -1.0, 0.5), Vec3::new(0.0, 1.0, 0.0));
+        let r = RayBoxes::new(&ray);
+        let mut t = [0.0; 4];
+        assert_eq!(boxes_portable(&n, &r, f32::INFINITY, &mut t), 0b11);
+        assert_eq!((t[0], t[1]), (1.0, 3.0));
+        #[cfg(target_arch = "x86_64")]
+        {
+            let mut t4 = [0.0; 4];
+            assert_eq!(boxes_sse(&n, &r, f32::INFINITY, &mut t4), 0b11);
+            assert_eq!(t4.map(f32::to_bits), t.map(f32::to_bits));
+        }
+    }
+
+    #[test]
+    fn triangle_filter_keeps_every_hit() {
+        let mut rng = raylab_core::Pcg32::new(5, 1);
+        let mut b = TriBlock::EMPTY_BLOCK;
+        let tris: Vec<[Vec3; 3]> = (0..3).map(|_| [0, 1, 2].map(|_| Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) - 0.5)).collect();
+        for (l, v) in tris.iter().enumerate() {
+            b.set_triangle(l, l as u32, *v);
+        }
+        let mut kept = 0;
+        for _ in 0..5000 {
+            let o = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 4.0 - 2.0;
+            let ray = Ray::new(o, (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) - 0.5 - o).normalize());
+            let s = ShearedRay::new(&ray);
+            let m = triangle_candidates(&b, &s);
+            assert_eq!(m & 0b1000, 0, "the empty lane is never a candidate");
+            for (l, v) in tris.iter().enumerate() {
+                if raylab_core::intersect::triangle(&ray, v[0], v[1], v[2]).is_some() {
+                    assert_ne!(m & (1 << l), 0, "a hit was filtered out");
+                    kept += 1;
+                }
+            }
+        }
+        assert!(kept > 100, "too few hits to test the filter: {kept}");
+    }
+
+    /// The SSE filter gives the portable filter's mask, also on degenerate triangles
+    /// (zero area, vertices at the origin: zero edge functions) and huge coordinates
+    /// (infinite or NaN edge functions).
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn sse_triangle_filter_matches_portable() {
+        let mut rng = raylab_core::Pcg32::new(6, 1);
+        let mut r = |scale: f32| Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, rng.next_f32() - 0.5) * scale;
+        for k in 0..20000 {
+            let mut b = TriBlock::EMPTY_BLOCK;
+            for l in 0..(k % 4 + 1) {
+                let scale = [1.0, 1e-30, 1e30, 3e38][(k / 4) % 4];
+                let v = match (k + l) % 5 {
+                    0 => [Vec3::ZERO; 3],
+                    1 => { let p = r(scale); [p, p, r(scale)] }
+                    _ => [r(scale), r(scale), r(scale)],
+                };
+                b.set_triangle(l, l as u32, v);
+            }
+            if k % 7 == 0 {
+                b.prim[0] = 3 | TriBlock::OTHER;
+            }
+            let o = if k % 3 == 0 { Vec3::ZERO } else { r(2.0) };
+            let ray = Ray::new(o, (r(1.0) + Vec3::splat(1e-3)).normalize());
+            let s = ShearedRay::new(&ray);
+            assert_eq!(triangle_candidates_sse(&b, &s), triangle_candidates(&b, &s), "block {k}");
+        }
+    }
+}

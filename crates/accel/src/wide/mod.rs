@@ -1,0 +1,289 @@
+//! Wide BVHs: a layout converted from any binary BVH (tinybvh's `ConvertFrom`, obvhs's
+//! `bvh2` → `cwbvh`), not a builder of its own. Nodes hold `W` = 4 or 8 child boxes in SoA
+//! form, tested at once with SIMD; leaves hold blocks of four triangles copied from the
+//! mesh (Embree's `Triangle4`), tested without index indirection.
+//!
+//! - `node.rs`: the memory layout and its byte budget;
+//! - `collapse.rs`: binary → wide, Embree's largest-area-first opening;
+//! - `kernels.rs`: box and triangle kernels, SIMD and portable with identical answers;
+//! - `traverse.rs`: closest and any hit, counting or not.
+
+mod collapse;
+pub mod kernels;
+pub mod node;
+mod traverse;
+
+use raylab_core::{Aabb, Ray};
+
+use crate::bvh::Bvh;
+use crate::{Accel, AccelStats, Counters, Hit, Primitives, ValidationError};
+use node::{is_leaf, leaf_blocks, ChildRef, TriBlock, WideNode, EMPTY};
+
+pub use collapse::LEAF_PRIMS;
+
+/// Which kernels a traversal runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kernel {
+    /// Plain Rust, on any CPU.
+    Portable,
+    /// `std::arch`: AVX2 for 8-wide nodes, SSE2 for 4-wide (x86-64 only).
+    Simd,
+}
+
+impl Kernel {
+    /// The fastest kernel this CPU runs for width `w` (runtime detection: the binary stays
+    /// portable, no `target-cpu` needed).
+    pub fn detect(w: usize) -> Kernel {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if w == 4 || (w == 8 && std::is_x86_feature_detected!("avx2")) {
+                return Kernel::Simd;
+            }
+        }
+        let _ = w;
+        Kernel::Portable
+    }
+}
+
+/// A `W`-wide BVH.
+///
+/// Invariants: `root` is [`EMPTY`] exactly when there are no primitives; every interior
+/// reference indexes `nodes`, every leaf reference a range of `blocks`; every primitive is
+/// in some block lane.
+#[derive(Debug)]
+pub struct WideBvh<const W: usize> {
+    pub nodes: Vec<WideNode<W>>,
+    pub blocks: Vec<TriBlock>,
+    pub root: ChildRef,
+    root_bounds: Aabb,
+    pub name: &'static str,
+    pub(crate) build_ms: f64,
+    primitives: usize,
+    spatial_splits: bool,
+    kernel: Kernel,
+}
+
+impl<const W: usize> WideBvh<W> {
+    /// Converts a binary BVH built over `prims`.
+    pub fn from_binary<P: Primitives + ?Sized>(bvh: &Bvh, prims: &P, name: &'static str) -> Self {
+        const { assert!(W == 4 || W == 8, "wide BVHs are 4 or 8 wide") };
+        let c = collapse::collapse::<P, W>(bvh, prims);
+        Self { nodes: c.nodes, blocks: c.blocks, root: c.root, root_bounds: c.root_bounds, name, build_ms: 0.0, primitives: prims.len(), spatial_splits: bvh.spatial_splits, kernel: Kernel::detect(W) }
+    }
+
+    /// Forces a kernel (tests compare the SIMD and portable ones). Asking for
+    /// [`Kernel::Simd`] on a CPU without it keeps the portable one.
+    pub fn with_kernel(mut self, k: Kernel) -> Self {
+        self.kernel = if k == Kernel::Simd { Kernel::detect(W) } else { k };
+        self
+    }
+
+    pub fn kernel(&self) -> Kernel {
+        self.kernel
+    }
+
+    pub fn root_bounds(&self) -> Aabb {
+        self.root_bounds
+    }
+
+    /// Closest hit without counting: the fast path (`raylab trace`).
+    #[inline]
+    pub fn intersect_fast<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray) -> Option<Hit> {
+        self.closest_dispatch::<P, false>(prims, ray, &mut Counters::default())
+    }
+
+    /// Any hit without counting.
+    #[inline]
+    pub fn occluded_fast<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray) -> bool {
+        self.any_dispatch::<P, false>(prims, ray, &mut Counters::default())
+    }
+
+    #[inline]
+    fn closest_dispatch<P: Primitives + ?Sized, const COUNT: bool>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
+        #[cfg(target_arch = "x86_64")]
+        if self.kernel == Kernel::Simd {
+            if W == 8 {
+                // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
+                return unsafe { closest_avx2::<P, W, COUNT>(self, prims, ray, c) };
+            }
+            return traverse::closest::<P, W, true, COUNT>(self, prims, ray, c);
+        }
+        traverse::closest::<P, W, false, COUNT>(self, prims, ray, c)
+    }
+
+    #[inline]
+    fn any_dispatch<P: Primitives + ?Sized, const COUNT: bool>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if self.kernel == Kernel::Simd {
+            if W == 8 {
+                // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
+                return unsafe { any_avx2::<P, W, COUNT>(self, prims, ray, c) };
+            }
+            return traverse::any::<P, W, true, COUNT>(self, prims, ray, c);
+        }
+        traverse::any::<P, W, false, COUNT>(self, prims, ray, c)
+    }
+
+    /// Calls `f(reference, bounds, depth)` for every child reference, depth first.
+    fn walk(&self, mut f: impl FnMut(ChildRef, &Aabb, usize)) {
+        if self.root == EMPTY {
+            return;
+        }
+        let mut stack = vec![(self.root, self.root_bounds, 1usize)];
+        while let Some((r, b, depth)) = stack.pop() {
+            f(r, &b, depth);
+            if !is_leaf(r) {
+                let n = &self.nodes[r as usize];
+                for lane in 0..W {
+                    if n.child[lane] != EMPTY {
+                        stack.push((n.child[lane], n.child_bounds(lane), depth + 1));
+                    }
+                }
+            }
+        }
+    }
+
+    fn leaf_prims(&self, r: ChildRef) -> impl Iterator<Item = u32> + '_ {
+        let (first, n) = leaf_blocks(r);
+        self.blocks[first..first + n].iter().flat_map(|b| b.prim).filter(|&p| p != EMPTY).map(|p| p & !TriBlock::OTHER)
+    }
+}
+
+/// The AVX2 instantiations: the whole traversal is compiled with AVX2 so that the box
+/// kernel inlines into it.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn closest_avx2<P: Primitives + ?Sized, const W: usize, const COUNT: bool>(bvh: &WideBvh<W>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
+    traverse::closest::<P, W, true, COUNT>(bvh, prims, ray, c)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn any_avx2<P: Primitives + ?Sized, const W: usize, const COUNT: bool>(bvh: &WideBvh<W>, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
+    traverse::any::<P, W, true, COUNT>(bvh, prims, ray, c)
+}
+
+impl<const W: usize> Accel for WideBvh<W> {
+    #[inline]
+    fn intersect<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
+        self.closest_dispatch::<P, true>(prims, ray, c)
+    }
+
+    #[inline]
+    fn occluded<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
+        self.any_dispatch::<P, true>(prims, ray, c)
+    }
+
+    fn stats(&self) -> AccelStats {
+        let mut s = AccelStats {
+            name: self.name.into(),
+            build_ms: self.build_ms,
+            primitives: self.primitives,
+            memory_bytes: self.nodes.len() * std::mem::size_of::<WideNode<W>>() + self.blocks.len() * std::mem::size_of::<TriBlock>(),
+            ..Default::default()
+        };
+        let root_area = (self.root_bounds.half_area() as f64).max(f64::MIN_POSITIVE);
+        let mut cost = 0.0;
+        self.walk(|r, b, depth| {
+            s.max_depth = s.max_depth.max(depth);
+            let rel = b.half_area() as f64 / root_area;
+            if is_leaf(r) {
+                let n = self.leaf_prims(r).count();
+                s.add_leaf(n);
+                // A block of four is tested as one SIMD step plus its candidates: charge
+                // blocks, the unit the kernel works in.
+                cost += rel * leaf_blocks(r).1 as f64;
+            } else {
+                s.interior_nodes += 1;
+                cost += rel;
+            }
+        });
+        s.sah_cost = cost;
+        let blocks_used = self.blocks.iter().map(|b| b.prim.iter().filter(|&&p| p != EMPTY).count()).sum::<usize>();
+        s.note("width", W);
+        s.note("kernel", format!("{:?}", self.kernel));
+        s.note("block fill", format!("{:.0}%", 100.0 * blocks_used as f64 / (4 * self.blocks.len()).max(1) as f64));
+        s.note("bytes/triangle", format!("{:.1}", s.memory_bytes as f64 / self.primitives.max(1) as f64));
+        s
+    }
+
+    fn validate<P: Primitives + ?Sized>(&self, prims: &P) -> Result<(), ValidationError> {
+        let err = |m: String| Err(ValidationError::new(self.name, m));
+        if prims.len() != self.primitives {
+            return err(format!("built for {} primitives, given {}", self.primitives, prims.len()));
+        }
+        if self.root == EMPTY {
+            return if prims.is_empty() { Ok(()) } else { err("no root for a non-empty scene".into()) };
+        }
+        let mut seen = vec![false; prims.len()];
+        let mut reached = vec![false; self.nodes.len()];
+        let mut problem = None;
+        self.walk(|r, b, _| {
+            if problem.is_some() {
+                return;
+            }
+            if is_leaf(r) {
+                let (first, n) = leaf_blocks(r);
+                if first + n > self.blocks.len() {
+                    problem = Some(format!("leaf {r:#x} points past the blocks"));
+                    return;
+                }
+                for (k, blk) in self.blocks[first..first + n].iter().enumerate() {
+                    for lane in 0..4 {
+                        let p = blk.prim[lane];
+                        if p == EMPTY {
+                            continue;
+                        }
+                        let i = p & !TriBlock::OTHER;
+                        if i as usize >= prims.len() {
+                            problem = Some(format!("block {} holds primitive {i} of {}", first + k, prims.len()));
+                            return;
+                        }
+                        seen[i as usize] = true;
+                        let copy = (p & TriBlock::OTHER == 0).then(|| [0, 1, 2].map(|v| blk.vertex(lane, v)));
+                        if copy != prims.triangle(i) {
+                            problem = Some(format!("block {} lane {lane}: triangle data of primitive {i} differs from the mesh", first + k));
+                            return;
+                        }
+                        let pb = prims.bounds(i);
+                        let inside = if self.spatial_splits { !pb.intersection(*b).is_empty() } else { b.contains_box(&pb) };
+                        if !inside {
+                            problem = Some(format!("primitive {i} {} leaf box", if self.spatial_splits { "does not touch its" } else { "sticks out of its" }));
+                            return;
+                        }
+                    }
+                }
+            } else {
+                let i = r as usize;
+                if i >= self.nodes.len() || reached[i] {
+                    problem = Some(format!("node {i} out of range or reached twice"));
+                    return;
+                }
+                reached[i] = true;
+                let n = &self.nodes[i];
+                for lane in 0..W {
+                    let cb = n.child_bounds(lane);
+                    if n.child[lane] == EMPTY {
+                        if cb.min.cmplt(cb.max).any() {
+                            problem = Some(format!("node {i} lane {lane}: an empty slot with a non-empty box"));
+                            return;
+                        }
+                    } else if !b.contains_box(&cb) {
+                        problem = Some(format!("node {i} lane {lane} sticks out of its parent"));
+                        return;
+                    }
+                }
+            }
+        });
+        if let Some(m) = problem {
+            return err(m);
+        }
+        if let Some(i) = reached.iter().position(|r| !r) {
+            return err(format!("node {i} is unreachable"));
+        }
+        if let Some(p) = seen.iter().position(|s| !s) {
+            return err(format!("primitive {p} is in no leaf"));
+        }
+        Ok(())
+    }
+}

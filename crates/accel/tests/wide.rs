@@ -1,0 +1,127 @@
+//! Wide BVHs: the SIMD and portable kernels give bit-identical answers (same primitive,
+//! distance and barycentrics), the counting and fast paths agree, and the layouts hold
+//! the triangles they were built from.
+
+use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Kernel, Primitives};
+use raylab_core::{Aabb, Pcg32, Ray, Vec3};
+use raylab_testkit::{self as kit, Soup};
+
+const WIDE: [AccelKind; 3] = [AccelKind::Bvh8, AccelKind::Bvh4, AccelKind::Bvh8Sbvh];
+
+fn check_kernels_agree(name: &str, soup: &Soup, rays: &[Ray]) {
+    for kind in WIDE {
+        let simd = AnyAccel::build(kind, soup, &BuildOptions::default()).with_kernel(Kernel::Simd);
+        let portable = AnyAccel::build(kind, soup, &BuildOptions::default()).with_kernel(Kernel::Portable);
+        portable.validate(soup).unwrap_or_else(|e| panic!("{name}/{kind}: {e}"));
+        let (mut cs, mut cp) = (Counters::default(), Counters::default());
+        for (k, ray) in rays.iter().enumerate() {
+            let (s, p) = (simd.intersect(soup, ray, &mut cs), portable.intersect(soup, ray, &mut cp));
+            assert_eq!(s, p, "{name}/{kind} ray {k}: SIMD vs portable");
+            assert_eq!(simd.intersect_fast(soup, ray), s, "{name}/{kind} ray {k}: fast vs counting path");
+            assert_eq!(portable.intersect_fast(soup, ray), s, "{name}/{kind} ray {k}: portable fast path");
+            let short = Ray { t_max: s.map_or(1.0, |h| h.t * 0.75), ..*ray };
+            for r in [ray, &short] {
+                let any = simd.occluded(soup, r, &mut cs);
+                assert_eq!(portable.occluded(soup, r, &mut cp), any, "{name}/{kind} ray {k}: any hit");
+                assert_eq!(simd.occluded_fast(soup, r), any, "{name}/{kind} ray {k}: fast any hit");
+            }
+        }
+        // Same traversal, same work: the kernels differ only in how lanes are computed.
+        assert_eq!(cs, cp, "{name}/{kind}: counters");
+        assert!(cs.nodes_visited > 0 || soup.is_empty(), "{name}/{kind}: nothing counted");
+    }
+}
+
+#[test]
+fn simd_and_portable_agree_on_soups_and_degenerate_rays() {
+    let mut rng = Pcg32::new(21, 1);
+    let unit = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
+    for n in [0, 1, 5, 300, 3000] {
+        let soup = kit::random_triangles(&mut rng, n, &unit, 0.2);
+        let mut rays = kit::random_rays(&mut rng, 1000, &Aabb::new(Vec3::splat(-2.0), Vec3::splat(2.0)), &unit);
+        // Rays lying in box planes (zero direction components): NaN slab distances.
+        rays.push(Ray::new(Vec3::new(-2.0, 0.0, 0.0), Vec3::X));
+        rays.push(Ray::new(Vec3::new(0.0, -2.0, 1.0), Vec3::Y));
+        rays.push(Ray::new(Vec3::new(0.0, 0.0, 0.0), -Vec3::Z));
+        check_kernels_agree(&format!("soup{n}"), &soup, &rays);
+    }
+    let mut mixed = kit::random_spheres(&mut rng, 200, &unit, 0.1);
+    mixed.push_object(kit::random_triangles(&mut rng, 500, &unit, 0.1));
+    mixed.push_object(kit::cube());
+    let rays = kit::random_rays(&mut rng, 1000, &unit, &unit);
+    check_kernels_agree("mixed", &mixed, &rays);
+}
+
+#[test]
+fn simd_and_portable_agree_on_the_bunny() {
+    let soup = kit::read_obj_triangles(&kit::shared_scenes().join("bunny_4968.obj"));
+    let b = soup.bounds();
+    let mut rng = Pcg32::new(22, 1);
+    let rays = kit::random_rays(&mut rng, 3000, &Aabb::new(b.min - b.extent(), b.max + b.extent()), &b);
+    check_kernels_agree("bunny", &soup, &rays);
+}
+
+/// Leaves hold full blocks: a wide tree over the bunny has far fewer nodes than the binary
+/// one, at most four triangles per block, and reports its layout.
+#[test]
+fn collapse_shape_on_the_bunny() {
+    let soup = kit::read_obj_triangles(&kit::shared_scenes().join("bunny_4968.obj"));
+    let bin = AnyAccel::build(AccelKind::Bvh, &soup, &BuildOptions::default()).stats();
+    for (kind, width) in [(AccelKind::Bvh8, 8usize), (AccelKind::Bvh4, 4)] {
+        let s = AnyAccel::build(kind, &soup, &BuildOptions::default()).stats();
+        println!("{s}");
+        assert_eq!(s.references, soup.len(), "{kind}: every triangle once");
+        // A binary tree of n interior nodes has n + 1 leaves; opening up to `width` children
+        // per wide node leaves at most about n / (width - 1) of them, plus partly filled ones.
+        assert!(s.interior_nodes * (width - 1) <= 2 * bin.interior_nodes, "{kind}: {} wide nodes for {} binary", s.interior_nodes, bin.interior_nodes);
+        assert!(s.max_depth < bin.max_depth, "{kind}: depth {} vs binary {}", s.max_depth, bin.max_depth);
+        assert!(s.leaf_histogram.iter().skip(5).all(|&c| c == 0) || s.leaf_histogram.len() <= 5, "{kind}: merged leaves above 4: {:?}", s.leaf_histogram);
+        assert!(s.notes.iter().any(|(k, v)| k == "width" && *v == width.to_string()));
+    }
+}
+
+/// Rays aimed exactly at shared vertices and edges of a closed cube from inside: the
+/// watertight kernel hits every one, through the SIMD filter too.
+#[test]
+fn watertight_from_inside_the_cube() {
+    let soup = kit::cube();
+    let mut rng = Pcg32::new(23, 1);
+    let corners: Vec<Vec3> = (0..8).map(|k| Vec3::new((k & 1) as f32, ((k >> 1) & 1) as f32, ((k >> 2) & 1) as f32) - 0.5).collect();
+    for kind in WIDE {
+        for kernel in [Kernel::Simd, Kernel::Portable] {
+            let accel = AnyAccel::build(kind, &soup, &BuildOptions::default()).with_kernel(kernel);
+            for _ in 0..2000 {
+                let o = kit::random_point(&mut rng, &Aabb::new(Vec3::splat(-0.4), Vec3::splat(0.4)));
+                let a = corners[rng.below(8) as usize];
+                let b = corners[rng.below(8) as usize];
+                for target in [a, 0.5 * (a + b)] {
+                    let Some(d) = (target - o).try_normalize() else { continue };
+                    let ray = Ray::new(o, d);
+                    assert!(accel.intersect(&soup, &ray, &mut Counters::default()).is_some(), "{kind}/{kernel:?}: ray from {o} to {target} escaped");
+                }
+            }
+        }
+    }
+}
+
+/// A binary leaf too large for one leaf reference (more than 16 blocks) is spread over a
+/// wide node of smaller leaves, and still answers as the oracle does.
+#[test]
+fn oversized_binary_leaf_is_split() {
+    use raylab_accel::bvh::{Bvh, BvhNode};
+    use raylab_accel::WideBvh;
+    let mut rng = Pcg32::new(24, 1);
+    let unit = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
+    let soup = kit::random_triangles(&mut rng, 300, &unit, 0.2);
+    let bin = Bvh::from_parts(vec![BvhNode::leaf(soup.bounds(), 0, 300)], (0..300).collect(), 300, "one leaf");
+    let oracle = AnyAccel::build(AccelKind::None, &soup, &BuildOptions::default());
+    for kernel in [Kernel::Simd, Kernel::Portable] {
+        let wide = WideBvh::<8>::from_binary(&bin, &soup, "bvh8").with_kernel(kernel);
+        wide.validate(&soup).unwrap();
+        assert!(!wide.nodes.is_empty(), "the leaf was not split");
+        let mut c = Counters::default();
+        for ray in kit::random_rays(&mut rng, 500, &unit, &unit) {
+            assert_eq!(wide.intersect(&soup, &ray, &mut c).map(|h| h.t), oracle.intersect(&soup, &ray, &mut c).map(|h| h.t));
+        }
+    }
+}
