@@ -27,7 +27,7 @@ pub fn load(path: Option<&std::path::Path>, o: &Overrides) -> PyResult<RScene> {
 }
 
 /// Renders `scene` on a worker thread (in a pool of `threads` when given) while polling
-/// for Ctrl-C; `integrator` replaces the scene's for AOVs.
+/// for Ctrl-C.
 pub fn render_interruptible(py: Python<'_>, scene: Arc<RScene>, threads: Option<u32>) -> PyResult<RenderOutput> {
     let pool = settings::pool(threads)?;
     interrupt::run(py, move |_cancel| settings::install(pool.as_ref(), || raylab_render::render(&scene, &|_| {})))

@@ -1,6 +1,7 @@
 """Type stubs of raylab's native module (re-exported by the ``raylab`` package)."""
 
 import os
+import pathlib
 from typing import Any, Dict, List, Literal, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
@@ -153,7 +154,7 @@ class Scene:
 
     def __init__(self, path: Optional[_Path] = None, **overrides: Any) -> None: ...
     @property
-    def path(self) -> Optional[str]: ...
+    def path(self) -> Optional[pathlib.Path]: ...
     @property
     def settings(self) -> Dict[str, Any]:
         """width, height, spp, sampler, max_depth, integrator, light_sampling, light_cells,
