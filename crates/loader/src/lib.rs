@@ -1,7 +1,7 @@
 //! The only crate that reads (and writes) files. Every format is a front end that produces
 //! a [`SceneDescription`]; one builder ([`build::build_scene`]) turns a description into a
 //! render scene: parse -> description -> build, as pbrt-v4 does. Front ends: TOML
-//! ([`scene`]), bare meshes (OBJ/MTL, PLY: [`mesh_scene`]). Every error names the file, the
+//! ([`scene`]), pbrt-v4 ([`pbrt`]), bare meshes (OBJ/MTL, PLY: [`mesh_scene`]). Every error names the file, the
 //! line and the field.
 
 pub mod build;
@@ -13,6 +13,7 @@ pub mod image_io;
 pub mod mesh_scene;
 pub mod obj;
 pub mod patches;
+pub mod pbrt;
 pub mod ply;
 pub mod scene;
 mod toml_read;
@@ -25,12 +26,16 @@ pub use error::LoadError;
 pub use scene::{load_scene, load_scene_str, parse_scene_str, Overrides};
 
 /// The scene formats `raylab render FILE` opens, for messages.
-pub const SCENE_EXTENSIONS: &str = ".toml, .obj, .obj.gz, .ply, .ply.gz";
+pub const SCENE_EXTENSIONS: &str = ".toml, .pbrt, .obj, .obj.gz, .ply, .ply.gz";
 
 /// Reads any scene file or bare mesh into a description, chosen by extension; an unknown
-/// extension is an error listing the supported ones.
-pub fn parse_any(path: &Path) -> Result<SceneDescription, LoadError> {
+/// extension is an error listing the supported ones. `lenient`: skip, with a warning, what
+/// a front end does not support.
+pub fn parse_any(path: &Path, lenient: bool) -> Result<SceneDescription, LoadError> {
     let name = path.to_string_lossy();
+    if name.to_ascii_lowercase().ends_with(".pbrt") {
+        return pbrt::parse_pbrt(path, lenient);
+    }
     if mesh_scene::MeshFormat::of(&name).is_some() {
         return mesh_scene::parse_mesh_scene(path);
     }
@@ -44,7 +49,11 @@ pub fn parse_any(path: &Path) -> Result<SceneDescription, LoadError> {
 
 /// Loads a scene file (`.toml`) or a bare mesh (`.obj`, `.ply`, gzipped or not).
 pub fn load_scene_or_mesh(path: &Path, overrides: &Overrides) -> Result<raylab_render::Scene, LoadError> {
-    build_scene(parse_any(path)?, overrides)
+    let desc = parse_any(path, overrides.lenient)?;
+    for w in &desc.warnings {
+        eprintln!("warning: {w}");
+    }
+    build_scene(desc, overrides)
 }
 
 /// A bare mesh (OBJ, PLY) as a scene framed by the camera.

@@ -43,6 +43,9 @@ pub struct Overrides {
     pub filter: Option<PixelFilter>,
     /// Parameters of the acceleration structure's build (SAH costs, leaf size, bins, ...).
     pub build: Option<BuildOptions>,
+    /// Front ends warn about and skip what they do not support instead of failing (pbrt-v4
+    /// directives outside raylab's subset).
+    pub lenient: bool,
 }
 
 impl Overrides {
