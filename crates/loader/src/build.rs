@@ -1,7 +1,7 @@
 //! The one builder: a [`SceneDescription`] and the command line's overrides to a render
 //! [`Scene`] with its acceleration structure.
 
-use raylab_render::{Camera, IntegratorKind, Light, RenderSettings, Scene};
+use raylab_render::{Camera, IntegratorKind, Light, RenderSettings, SamplerKind, Scene};
 
 use crate::description::SceneDescription;
 use crate::error::LoadError;
@@ -12,6 +12,12 @@ pub fn settings(desc: &SceneDescription, overrides: &Overrides) -> Result<Render
     let mut s = RenderSettings::default();
     desc.settings.apply(&mut s);
     overrides.apply(&mut s);
+    if let Some(n) = jittered_strata(s.sampler, s.spp) {
+        // Stratification needs n × n samples: round up, as Mitsuba's stratified sampler does,
+        // and say so once rather than fail.
+        eprintln!("note: the jittered sampler stratifies {n}×{n}: {} samples per pixel rounded up to {}", s.spp, n * n);
+        s.spp = n * n;
+    }
     if let Err(e) = s.sampler.check_spp(s.spp) {
         return Err(match (overrides.spp, &desc.spp_span) {
             (None, Some(span)) => span.err(e),
@@ -20,6 +26,16 @@ pub fn settings(desc: &SceneDescription, overrides: &Overrides) -> Result<Render
         });
     }
     Ok(s)
+}
+
+/// The side of the square grid of strata a non-square `spp` is rounded up to, for the
+/// jittered sampler; `None` when nothing needs rounding.
+pub fn jittered_strata(sampler: SamplerKind, spp: u32) -> Option<u32> {
+    if sampler != SamplerKind::Jittered || spp == 0 {
+        return None;
+    }
+    let n = (spp as f64).sqrt().ceil() as u32;
+    (n * n != spp).then_some(n)
 }
 
 /// Builds the scene the description describes, with the acceleration structure and build
@@ -67,3 +83,18 @@ pub fn black_render_warnings(scene: &Scene) -> Vec<String> {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jittered_spp_rounds_up_to_the_next_square() {
+        assert_eq!(jittered_strata(SamplerKind::Jittered, 5), Some(3));
+        assert_eq!(jittered_strata(SamplerKind::Jittered, 10), Some(4));
+        assert_eq!(jittered_strata(SamplerKind::Jittered, 16), None);
+        assert_eq!(jittered_strata(SamplerKind::Jittered, 1), None);
+        assert_eq!(jittered_strata(SamplerKind::Sobol, 5), None);
+    }
+}
+

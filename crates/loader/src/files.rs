@@ -68,16 +68,16 @@ impl Resolver {
             }
             Resolver::Disk { base } => {
                 let mut tried = Vec::new();
-                // A scene named without a folder (`raylab render bunny.toml`) has an empty
-                // parent, which `std::path::absolute` refuses: it is the current directory.
-                let base = if base.as_os_str().is_empty() { Path::new(".") } else { base.as_path() };
                 let direct = base.join(name);
                 if direct.is_file() {
                     return Ok(Found::Disk(direct));
                 }
                 tried.push(direct);
                 if Path::new(name).is_relative() {
-                    let abs = std::path::absolute(base).unwrap_or_else(|_| base.to_path_buf());
+                    // A scene named without a folder (`cd scenes && raylab render bunny.toml`) has an
+                    // empty parent, which `std::path::absolute` refuses: it is the current directory.
+                    let dir = if base.as_os_str().is_empty() { Path::new(".") } else { base.as_path() };
+                    let abs = std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf());
                     for dir in abs.ancestors() {
                         let candidate = dir.join("shared").join("scenes").join(name);
                         if candidate.is_file() {
