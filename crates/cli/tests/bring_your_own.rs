@@ -43,7 +43,7 @@ fn unknown_formats_are_rejected_by_extension() {
     std::fs::write(dir.join("model.fbx"), "binary").unwrap();
     let o = raylab(&["render", "model.fbx"], &dir);
     assert_eq!(o.status.code(), Some(1));
-    assert_eq!(stderr(&o).trim_end(), "raylab: error: model.fbx: unsupported file type (supported: .toml, .pbrt, .obj, .obj.gz, .ply, .ply.gz)");
+    assert_eq!(stderr(&o).trim_end(), "raylab: error: model.fbx: unsupported file type (supported: .toml, .pbrt, .gltf, .glb, .obj, .obj.gz, .ply, .ply.gz)");
 }
 
 #[test]

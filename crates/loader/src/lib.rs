@@ -1,7 +1,7 @@
 //! The only crate that reads (and writes) files. Every format is a front end that produces
 //! a [`SceneDescription`]; one builder ([`build::build_scene`]) turns a description into a
 //! render scene: parse -> description -> build, as pbrt-v4 does. Front ends: TOML
-//! ([`scene`]), pbrt-v4 ([`pbrt`]), bare meshes (OBJ/MTL, PLY: [`mesh_scene`]). Every error names the file, the
+//! ([`scene`]), pbrt-v4 ([`pbrt`]), glTF 2.0 ([`gltf`]), bare meshes (OBJ/MTL, PLY: [`mesh_scene`]). Every error names the file, the
 //! line and the field.
 
 pub mod build;
@@ -9,6 +9,7 @@ mod curves;
 pub mod description;
 pub mod error;
 pub mod files;
+pub mod gltf;
 pub mod image_io;
 pub mod mesh_scene;
 pub mod obj;
@@ -26,13 +27,17 @@ pub use error::LoadError;
 pub use scene::{load_scene, load_scene_str, parse_scene_str, Overrides};
 
 /// The scene formats `raylab render FILE` opens, for messages.
-pub const SCENE_EXTENSIONS: &str = ".toml, .pbrt, .obj, .obj.gz, .ply, .ply.gz";
+pub const SCENE_EXTENSIONS: &str = ".toml, .pbrt, .gltf, .glb, .obj, .obj.gz, .ply, .ply.gz";
 
 /// Reads any scene file or bare mesh into a description, chosen by extension; an unknown
 /// extension is an error listing the supported ones. `lenient`: skip, with a warning, what
 /// a front end does not support.
 pub fn parse_any(path: &Path, lenient: bool) -> Result<SceneDescription, LoadError> {
     let name = path.to_string_lossy();
+    let lower = name.to_ascii_lowercase();
+    if lower.ends_with(".gltf") || lower.ends_with(".glb") {
+        return gltf::parse_gltf(path);
+    }
     if name.to_ascii_lowercase().ends_with(".pbrt") {
         return pbrt::parse_pbrt(path, lenient);
     }

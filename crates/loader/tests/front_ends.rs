@@ -152,7 +152,7 @@ fn pbrt_outside_the_subset_is_an_error_naming_file_line_and_directive() {
 #[test]
 fn unknown_extensions_and_empty_meshes_are_errors() {
     let e = load_scene_or_mesh(Path::new("scene.xml"), &Overrides::default()).unwrap_err().to_string();
-    assert_eq!(e, "scene.xml: unsupported file type (supported: .toml, .pbrt, .obj, .obj.gz, .ply, .ply.gz)");
+    assert_eq!(e, "scene.xml: unsupported file type (supported: .toml, .pbrt, .gltf, .glb, .obj, .obj.gz, .ply, .ply.gz)");
     let src = "[camera]\nfrom = [0, 0, 5]\nat = [0, 0, 0]\nvfov = 40\n[[shapes]]\ntype = \"mesh\"\nfile = \"bunny.stl\"\n";
     let e = load_scene_str(src, Path::new("s.toml"), &Resolver::Disk { base: data() }, &Overrides::default()).unwrap_err().to_string();
     assert_eq!(e, "s.toml:7: shapes[0].file: unsupported mesh format `bunny.stl` (supported: .obj, .obj.gz, .ply, .ply.gz)");
@@ -164,4 +164,61 @@ fn unknown_extensions_and_empty_meshes_are_errors() {
     let e = load_scene_or_mesh(&ply, &Overrides::default()).unwrap_err().to_string();
     assert_eq!(e, format!("{}: the mesh has no triangles", ply.display()));
     std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_bare_glb_from_trimesh_is_framed_like_the_obj() {
+    let o = Overrides { width: Some(48), height: Some(36), ..Default::default() };
+    let obj = load_scene_or_mesh(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/bunny_4968.obj"), &o).unwrap();
+    let glb = load_scene_or_mesh(&data().join("bunny.glb"), &o).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(glb.geometry.triangle_count(), 4968);
+    assert!((glb.camera.from - obj.camera.from).length() < 1e-5, "{} vs {}", glb.camera.from, obj.camera.from);
+    let e = mse(&pixels(&obj), &pixels(&glb));
+    assert!(e < 1e-4, "MSE {e}");
+}
+
+/// A hand-written glTF: node transforms, a camera, a KHR point light and a metallic material.
+#[test]
+fn gltf_nodes_camera_light_and_material_map_as_documented() {
+    let dir = std::env::temp_dir().join(format!("raylab_gltf_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bin: Vec<u8> = [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(dir.join("tri.bin"), &bin).unwrap();
+    let json = r#"{
+      "asset": {"version": "2.0"},
+      "extensionsUsed": ["KHR_lights_punctual"],
+      "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "color": [1, 0.5, 0.25], "intensity": 10}]}},
+      "scene": 0,
+      "scenes": [{"nodes": [0, 1, 2]}],
+      "nodes": [
+        {"mesh": 0, "translation": [1, 0, 0], "scale": [2, 2, 2]},
+        {"camera": 0, "translation": [0, 0, 5]},
+        {"translation": [0, 3, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}}
+      ],
+      "cameras": [{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
+      "materials": [{"name": "gold-ish", "pbrMetallicRoughness": {"baseColorFactor": [1, 0.8, 0.4, 1], "metallicFactor": 1, "roughnessFactor": 0.5}}],
+      "buffers": [{"uri": "tri.bin", "byteLength": 36}],
+      "bufferViews": [{"buffer": 0, "byteLength": 36}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}]
+    }"#;
+    std::fs::write(dir.join("tri.gltf"), json).unwrap();
+    let s = load_scene_or_mesh(&dir.join("tri.gltf"), &Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(s.geometry.meshes[0].positions, vec![Vec3::new(1.0, 0.0, 0.0), Vec3::new(3.0, 0.0, 0.0), Vec3::new(1.0, 2.0, 0.0)]);
+    assert_eq!(s.camera.from, Vec3::new(0.0, 0.0, 5.0));
+    assert!((s.camera.vfov - 0.5f32.to_degrees()).abs() < 1e-4);
+    assert_eq!(s.lights.len(), 1);
+    assert!(matches!(s.lights[0], raylab_render::Light::Point { position, intensity } if position == Vec3::new(0.0, 3.0, 0.0) && intensity == Rgb::new(10.0, 5.0, 2.5)));
+    let m = s.geometry.meshes[0].material;
+    assert_eq!(s.material_names[m.0 as usize], "gold-ish");
+    // Fully metallic: no diffuse, f0 = base colour, α = roughness².
+    match &s.materials[m.0 as usize] {
+        raylab_render::Material::CookTorrance { diffuse, f0, roughness, .. } => {
+            assert_eq!(*diffuse, raylab_render::material::TexColor::Constant(Rgb::ZERO));
+            assert_eq!(*f0, raylab_render::material::TexColor::Constant(Rgb::new(1.0, 0.8, 0.4)));
+            assert_eq!(*roughness, 0.25);
+        }
+        other => panic!("{other:?}"),
+    }
 }
