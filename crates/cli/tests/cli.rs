@@ -96,7 +96,9 @@ fn bad_input_fails_with_file_line_and_field() {
     write("radius.toml", &format!("{camera}[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = -1\n"));
     fails_with(&["render", "radius.toml"], &dir, "radius.toml:8: shapes[0].radius: must be positive, found -1");
     write("missing.toml", &format!("{camera}[[shapes]]\ntype = \"mesh\"\nfile = \"nope.obj\"\n"));
-    fails_with(&["inspect", "missing.toml"], &dir, "missing.toml:7: shapes[0].file: cannot find `nope.obj` (looked in nope.obj)");
+    // Looked up beside the scene, then in `shared/scenes` of every ancestor that has one.
+    let shared: String = dir.ancestors().map(|a| a.join("shared/scenes")).filter(|s| s.is_dir()).map(|s| format!(", {}", s.join("nope.obj").display())).collect();
+    fails_with(&["inspect", "missing.toml"], &dir, &format!("missing.toml:7: shapes[0].file: cannot find `nope.obj` (looked in nope.obj{shared})"));
     write("vfov.toml", "[camera]\nfrom = [0, 0, 5]\nat = [0, 0, 0]\nvfov = 180\n");
     fails_with(&["render", "vfov.toml"], &dir, "vfov.toml:4: camera.vfov: must be in (0, 180) degrees, found 180");
     write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
@@ -182,5 +184,5 @@ fn bake_writes_a_map_and_a_uv_mapped_mesh() {
     let obj = raylab_loader::obj::load_obj(&found, &raylab_core::Transform::IDENTITY).unwrap();
     let (mesh, _) = &obj.meshes[0];
     assert_eq!((mesh.len(), mesh.positions.len(), mesh.uvs.len(), mesh.normals.len()), (4968, 3 * 4968, 3 * 4968, 3 * 4968));
-    fails_with(&["bake", "--high", bunny, "--low", bunny, "-o", "n.png", "--size", "64"], &dir, "--size: a 64² texture is too small for 4968 triangles: cells of 1 texels");
+    fails_with(&["bake", "--high", bunny, "--low", bunny, "-o", "n.png", "--size", "64"], &dir, "--size: a 64² texture is too small for 4968 triangles: cells of 1 texels (use --size 512 or more)");
 }

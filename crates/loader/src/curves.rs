@@ -5,7 +5,9 @@
 use raylab_core::{Transform, Vec3, Vec4};
 use raylab_render::shape::curve::{tessellate, to_bezier_segments, Basis, Bezier, CurveMode};
 use raylab_render::shape::Curve;
-use raylab_render::{MaterialId, Scene};
+use raylab_render::MaterialId;
+
+use crate::description::SceneDescription;
 
 use crate::error::{text_from_bytes, LoadError};
 use crate::files::Found;
@@ -25,7 +27,7 @@ struct Strand {
 }
 
 /// Reads the curve shape `t` (its `file`, if any, already found) into `scene`.
-pub fn add_curves(scene: &mut Scene, t: &Table, file: Option<(Val, Found)>, material: MaterialId, to_world: &Transform) -> Result<(), LoadError> {
+pub fn add_curves(scene: &mut SceneDescription, t: &Table, file: Option<(Val, Found)>, material: MaterialId, to_world: &Transform) -> Result<(), LoadError> {
     let basis = t.opt("basis", |v| v.str()?.parse::<Basis>().map_err(|e| v.err(e)))?.unwrap_or(Basis::Bezier);
     let degree = t.opt("degree", |v| in_range(v, v.integer()?, 1, 3))?.unwrap_or(3) as usize;
     let mode = mode(t)?;

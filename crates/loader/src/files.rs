@@ -74,7 +74,10 @@ impl Resolver {
                 }
                 tried.push(direct);
                 if Path::new(name).is_relative() {
-                    let abs = std::path::absolute(base).unwrap_or_else(|_| base.clone());
+                    // A scene named without a folder (`cd scenes && raylab render bunny.toml`) has an
+                    // empty parent, which `std::path::absolute` refuses: it is the current directory.
+                    let dir = if base.as_os_str().is_empty() { Path::new(".") } else { base.as_path() };
+                    let abs = std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf());
                     for dir in abs.ancestors() {
                         let candidate = dir.join("shared").join("scenes").join(name);
                         if candidate.is_file() {

@@ -15,11 +15,14 @@ use raylab_render::shape::bezier_patch::DEFAULT_SUBDIVISIONS;
 use raylab_render::shape::{PatchSurfaces, DEFAULT_SEED_GRID};
 use raylab_render::shape::Sphere;
 use raylab_render::texture::{Checker, CheckerSpace, Filter, ImageTexture, Noise, NoiseKind, Wrap};
-use raylab_render::{Background, Camera, IntegratorKind, Light, Material, MaterialId, RenderSettings, SamplerKind, Scene, Texture, TriangleMesh};
+use raylab_render::{Background, IntegratorKind, Light, Material, MaterialId, RenderSettings, SamplerKind, Scene, Texture, TriangleMesh};
+
+use crate::description::{CameraDescription, SceneDescription, Span};
 
 use crate::error::LoadError;
 use crate::files::{not_found_message, Found, Resolver};
-use crate::obj::{load_obj, mtl_color, MtlMaterial};
+use crate::mesh_scene::load_mesh_file;
+use crate::obj::{mtl_color, MtlMaterial};
 use crate::patches::{load_patch_mesh, load_patches_world};
 use crate::toml_read::{in_range, in_range_f32, positive, Doc, Table, Val};
 
@@ -38,6 +41,11 @@ pub struct Overrides {
     pub accel: Option<AccelKind>,
     pub seed: Option<u64>,
     pub filter: Option<PixelFilter>,
+    /// Parameters of the acceleration structure's build (SAH costs, leaf size, bins, ...).
+    pub build: Option<BuildOptions>,
+    /// Front ends warn about and skip what they do not support instead of failing (pbrt-v4
+    /// directives outside raylab's subset).
+    pub lenient: bool,
 }
 
 impl Overrides {
@@ -81,8 +89,14 @@ pub fn load_scene(path: &Path, overrides: &Overrides) -> Result<Scene, LoadError
     load_scene_str(&src, path, &Resolver::Disk { base }, overrides)
 }
 
-/// Parses scene text; `path` names it in messages, `resolver` finds the files it names.
+/// Parses scene text and builds it; `path` names it in messages, `resolver` finds the
+/// files it names.
 pub fn load_scene_str(src: &str, path: &Path, resolver: &Resolver, overrides: &Overrides) -> Result<Scene, LoadError> {
+    crate::build::build_scene(parse_scene_str(src, path, resolver)?, overrides)
+}
+
+/// The TOML front end: scene text to a [`SceneDescription`] (every file it names read).
+pub fn parse_scene_str(src: &str, path: &Path, resolver: &Resolver) -> Result<SceneDescription, LoadError> {
     let doc = Doc::new(path, src);
     let root = doc.parse(src)?;
     let top = Table::new(&doc, String::new(), root.span(), root.get_ref(), TOP)?;
@@ -96,9 +110,9 @@ pub fn load_scene_str(src: &str, path: &Path, resolver: &Resolver, overrides: &O
         has_background: top.has("background"),
     };
 
-    let settings = b.settings(&top, overrides)?;
-    let camera = b.camera(&top, &settings)?;
-    let mut scene = Scene::new(camera, settings);
+    let camera = b.camera(&top)?;
+    let mut scene = SceneDescription::new(path, camera);
+    b.settings(&top, &mut scene)?;
     for t in top.tables("textures", TEXTURE)? {
         b.texture(&mut scene, &t)?;
     }
@@ -114,7 +128,6 @@ pub fn load_scene_str(src: &str, path: &Path, resolver: &Resolver, overrides: &O
     for l in top.tables("lights", LIGHT)? {
         b.light(&mut scene, &l)?;
     }
-    scene.build_accel(&BuildOptions::default());
     Ok(scene)
 }
 
@@ -132,63 +145,63 @@ struct Builder<'a> {
 }
 
 impl Builder<'_> {
-    fn settings(&self, top: &Table, o: &Overrides) -> Result<RenderSettings, LoadError> {
-        let mut s = RenderSettings::default();
+    /// The `[render]` table and the image size of `[camera]`, as the file gives them.
+    fn settings(&self, top: &Table, desc: &mut SceneDescription) -> Result<(), LoadError> {
+        let s = &mut desc.settings;
         if let Some(c) = top.get("camera") {
             let c = c.table(CAMERA)?;
             if let Some(v) = c.get("width") {
-                s.width = in_range(&v, v.integer()?, 1, 16384)? as u32;
+                s.width = Some(in_range(&v, v.integer()?, 1, 16384)? as u32);
             }
             if let Some(v) = c.get("height") {
-                s.height = in_range(&v, v.integer()?, 1, 16384)? as u32;
+                s.height = Some(in_range(&v, v.integer()?, 1, 16384)? as u32);
             }
         }
-        let mut spp_field = None;
         if let Some(r) = top.get("render") {
             let r = r.table(RENDER)?;
             if let Some(v) = r.get("spp") {
-                s.spp = in_range(&v, v.integer()?, 1, 1 << 20)? as u32;
-                spp_field = Some(v);
+                s.spp = Some(in_range(&v, v.integer()?, 1, 1 << 20)? as u32);
+                desc.spp_span = Some(self.span(&v));
             }
+            let s = &mut desc.settings;
             if let Some(v) = r.get("sampler") {
-                s.sampler = v.str()?.parse().map_err(|e: String| v.err(e))?;
+                s.sampler = Some(v.str()?.parse().map_err(|e: String| v.err(e))?);
             }
             if let Some(v) = r.get("max_depth") {
-                s.max_depth = in_range(&v, v.integer()?, 1, 1024)? as u32;
+                s.max_depth = Some(in_range(&v, v.integer()?, 1, 1024)? as u32);
             }
             if let Some(v) = r.get("integrator") {
-                s.integrator = v.str()?.parse().map_err(|e: String| v.err(e))?;
+                s.integrator = Some(v.str()?.parse().map_err(|e: String| v.err(e))?);
             }
             if let Some(v) = r.get("light_sampling") {
-                s.light_sampling = v.str()?.parse().map_err(|e: String| v.err(e))?;
+                s.light_sampling = Some(v.str()?.parse().map_err(|e: String| v.err(e))?);
             }
             if let Some(v) = r.get("mis_heuristic") {
-                s.mis_heuristic = v.str()?.parse().map_err(|e: String| v.err(e))?;
+                s.mis_heuristic = Some(v.str()?.parse().map_err(|e: String| v.err(e))?);
             }
             if let Some(v) = r.get("light_cells") {
-                s.light_cells = in_range(&v, v.integer()?, 1, MAX_CELLS as i64)? as u32;
+                s.light_cells = Some(in_range(&v, v.integer()?, 1, MAX_CELLS as i64)? as u32);
             }
             if let Some(v) = r.get("accel") {
-                s.accel = v.str()?.parse().map_err(|e: raylab_accel::UnknownAccel| v.err(e.to_string()))?;
+                s.accel = Some(v.str()?.parse().map_err(|e: raylab_accel::UnknownAccel| v.err(e.to_string()))?);
             }
             if let Some(v) = r.get("filter") {
-                s.filter = v.str()?.parse().map_err(|e: String| v.err(e))?;
+                s.filter = Some(v.str()?.parse().map_err(|e: String| v.err(e))?);
             }
             if let Some(v) = r.get("seed") {
-                s.seed = in_range(&v, v.integer()?, 0, i64::MAX)? as u64;
+                s.seed = Some(in_range(&v, v.integer()?, 0, i64::MAX)? as u64);
             }
         }
-        o.apply(&mut s);
-        if let Err(e) = s.sampler.check_spp(s.spp) {
-            return Err(match (o.spp, spp_field) {
-                (None, Some(v)) => v.err(e),
-                _ => LoadError::new(self.doc.file, None, "render.spp", e),
-            });
-        }
-        Ok(s)
+        Ok(())
     }
 
-    fn camera(&self, top: &Table, s: &RenderSettings) -> Result<Camera, LoadError> {
+    /// Where `v` is, for errors the builder reports.
+    fn span(&self, v: &Val) -> Span {
+        let e = v.err("");
+        Span { file: e.file, line: e.line, field: e.field }
+    }
+
+    fn camera(&self, top: &Table) -> Result<CameraDescription, LoadError> {
         let c = top.req("camera")?.table(CAMERA)?;
         let from = c.req("from")?.vec3()?;
         let at_v = c.req("at")?;
@@ -204,12 +217,10 @@ impl Builder<'_> {
         if aperture < 0.0 {
             return Err(c.get("aperture").unwrap().err(format!("must not be negative, found {aperture}")));
         }
-        let focus = c.opt("focus_distance", |v| positive(v, v.f32()?))?;
-        Camera::new(from, at, up, vfov, s.width as f32 / s.height as f32, aperture, focus).map_err(|e| {
-            let (field, msg) = e.split_once(": ").unwrap_or(("camera", &e));
-            let span = if field == "camera.up" { up_v.as_ref().unwrap_or(&at_v).span() } else { at_v.span() };
-            self.doc.err(&span, field, msg)
-        })
+        let focus_distance = c.opt("focus_distance", |v| positive(v, v.f32()?))?;
+        let at_span = self.span(&at_v);
+        let up_span = up_v.as_ref().map_or_else(|| at_span.clone(), |v| self.span(v));
+        Ok(CameraDescription { from, at, up, vfov, aperture, focus_distance, at_span, up_span })
     }
 
     fn find(&self, v: &Val) -> Result<Found, LoadError> {
@@ -222,7 +233,7 @@ impl Builder<'_> {
         ImageTexture::new(w, h, texels, wrap, filter).map_err(|e| v.err(format!("{}: {e}", found.path().display())))
     }
 
-    fn texture(&mut self, scene: &mut Scene, t: &Table) -> Result<(), LoadError> {
+    fn texture(&mut self, scene: &mut SceneDescription, t: &Table) -> Result<(), LoadError> {
         let name_v = t.req("name")?;
         let name = name_v.str()?.to_string();
         if self.texture_ids.contains_key(&name) {
@@ -300,7 +311,7 @@ impl Builder<'_> {
         v.color().map(TexColor::Constant)
     }
 
-    fn material(&mut self, scene: &mut Scene, t: &Table) -> Result<(), LoadError> {
+    fn material(&mut self, scene: &mut SceneDescription, t: &Table) -> Result<(), LoadError> {
         let name_v = t.req("name")?;
         let name = name_v.str()?.to_string();
         if self.material_ids.contains_key(&name) {
@@ -437,7 +448,7 @@ impl Builder<'_> {
         })
     }
 
-    fn background(&mut self, scene: &mut Scene, t: &Table) -> Result<Background, LoadError> {
+    fn background(&mut self, scene: &mut SceneDescription, t: &Table) -> Result<Background, LoadError> {
         match (t.get("color"), t.get("texture")) {
             (Some(_), Some(v)) => Err(v.err("give either `color` or `texture`, not both")),
             (Some(c), None) => Ok(Background::Color(c.color()?)),
@@ -483,7 +494,7 @@ impl Builder<'_> {
         Ok(m)
     }
 
-    fn shape(&mut self, scene: &mut Scene, t: &Table) -> Result<(), LoadError> {
+    fn shape(&mut self, scene: &mut SceneDescription, t: &Table) -> Result<(), LoadError> {
         let kind = t.type_name(&["sphere", "triangle", "quad", "mesh", "curve", "bezier_patch"])?;
         let valid: &[&str] = match kind {
             "sphere" => &["center", "radius"],
@@ -565,10 +576,11 @@ impl Builder<'_> {
             }
             _ => {
                 let fv = t.req("file")?;
+                crate::mesh_scene::MeshFormat::require(fv.str()?).map_err(|e| fv.err(e))?;
                 let found = self.find(&fv)?;
                 let smooth = t.opt("smooth", |v| v.bool())?.unwrap_or(false);
                 let crease = t.opt("crease_angle", |v| if smooth { in_range_f32(v, v.f32()?, 0.0, 180.0) } else { Err(v.err("needs `smooth = true`")) })?.unwrap_or(180.0);
-                let obj = load_obj(&found, &to_world)?;
+                let obj = load_mesh_file(&found, &to_world)?;
                 for (mut mesh, mtl) in obj.meshes {
                     if let Some(ke) = mtl.and_then(|k| obj.materials.get(k)).and_then(|m| m.emissive) {
                         mesh.emission = mtl_color(Some(ke), Rgb::ZERO);
@@ -590,7 +602,7 @@ impl Builder<'_> {
     }
 
     /// Converts an MTL material (once per file and index).
-    fn mtl_material(&mut self, scene: &mut Scene, v: &Val, mats: &[MtlMaterial], k: usize, mtl: Option<&Found>) -> Result<MaterialId, LoadError> {
+    fn mtl_material(&mut self, scene: &mut SceneDescription, v: &Val, mats: &[MtlMaterial], k: usize, mtl: Option<&Found>) -> Result<MaterialId, LoadError> {
         let key = (mtl.map(|f| f.path().display().to_string()).unwrap_or_default(), k);
         if let Some(&id) = self.mtl_cache.get(&key) {
             return Ok(id);
@@ -620,7 +632,7 @@ impl Builder<'_> {
         Ok(id)
     }
 
-    fn light(&mut self, scene: &mut Scene, t: &Table) -> Result<(), LoadError> {
+    fn light(&mut self, scene: &mut SceneDescription, t: &Table) -> Result<(), LoadError> {
         let kind = t.type_name(&["point", "directional", "ambient", "grid", "rect", "sphere", "environment"])?;
         let valid: &[&str] = match kind {
             "point" => &["position", "intensity"],
@@ -678,7 +690,7 @@ impl Builder<'_> {
 
     /// An equirectangular image (PNG, EXR, ...) around the scene, importance sampled; it is
     /// the background too.
-    fn environment_light(&mut self, scene: &mut Scene, t: &Table) -> Result<(), LoadError> {
+    fn environment_light(&mut self, scene: &mut SceneDescription, t: &Table) -> Result<(), LoadError> {
         let tv = t.req("type")?;
         if self.has_background {
             return Err(tv.err("an environment light is the scene's background: remove `[background]`"));
@@ -695,7 +707,7 @@ impl Builder<'_> {
     }
 
     /// Area lights are geometry that emits and reflects nothing (a black material).
-    fn area_light(&mut self, scene: &mut Scene, kind: &str, t: &Table) -> Result<(), LoadError> {
+    fn area_light(&mut self, scene: &mut SceneDescription, kind: &str, t: &Table) -> Result<(), LoadError> {
         let rv = t.req("radiance")?;
         let radiance = rv.color()?;
         if radiance.min_element() < 0.0 {
@@ -731,35 +743,4 @@ impl Builder<'_> {
         scene.geometry.add_mesh(mesh);
         Ok(())
     }
-}
-
-/// A bare mesh (OBJ or `.obj.gz`) as a scene: a camera framing its bounds from the front
-/// and above, a point light beside the camera, the default material.
-pub fn load_mesh_scene(path: &Path, overrides: &Overrides) -> Result<Scene, LoadError> {
-    let found = Found::Disk(path.to_path_buf());
-    if !path.is_file() {
-        return Err(LoadError::file(path, "cannot read: no such file"));
-    }
-    let obj = load_obj(&found, &Transform::IDENTITY)?;
-    let mut geometry = raylab_render::Geometry::default();
-    for (mesh, _) in obj.meshes {
-        geometry.add_mesh(mesh);
-    }
-    let b = geometry.total_bounds();
-    if b.is_empty() {
-        return Err(LoadError::file(path, "the mesh has no triangles"));
-    }
-    let mut settings = RenderSettings::default();
-    overrides.apply(&mut settings);
-    settings.sampler.check_spp(settings.spp).map_err(|e| LoadError::new(path, None, "--spp", e))?;
-    let center = b.centroid();
-    let radius = 0.5 * b.extent().length();
-    let from = center + Vec3::new(0.35, 0.45, 1.0).normalize() * radius * 2.6;
-    let camera = Camera::new(from, center, Vec3::Y, 40.0, settings.width as f32 / settings.height as f32, 0.0, None).map_err(|e| LoadError::file(path, e))?;
-    let mut scene = Scene::new(camera, settings);
-    scene.geometry = geometry;
-    scene.lights.push(Light::Point { position: from + Vec3::new(-radius, radius, 0.0), intensity: Rgb::splat(3.0 * radius * radius) });
-    scene.lights.push(Light::Ambient { intensity: Rgb::splat(0.1) });
-    scene.build_accel(&BuildOptions::default());
-    Ok(scene)
 }

@@ -9,17 +9,18 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use raylab_core::Transform;
 use raylab_lab::bake::{bake_normal_map, with_atlas_uvs};
-use raylab_loader::files::Found;
+use raylab_loader::files::{not_found_message, Resolver};
 use raylab_loader::image_io::write_linear_png;
-use raylab_loader::obj::{load_obj, obj_text};
+use raylab_loader::mesh_scene::load_mesh_file;
+use raylab_loader::obj::obj_text;
 use raylab_render::TriangleMesh;
 
 #[derive(Args, Clone, Debug)]
 pub struct BakeArgs {
-    /// The detailed mesh whose normals are baked (.obj or .obj.gz)
+    /// The detailed mesh whose normals are baked (.obj or .ply, gzipped or not; looked up in the shared scene folder too)
     #[arg(long)]
     pub high: PathBuf,
-    /// The simplified mesh that carries the map (.obj or .obj.gz); its UV-mapped copy is
+    /// The simplified mesh that carries the map (.obj or .ply, gzipped or not); its UV-mapped copy is
     /// written beside the map as <LOW>_uv.obj
     #[arg(long)]
     pub low: PathBuf,
@@ -45,7 +46,14 @@ pub fn run(a: &BakeArgs) -> Result<()> {
     let start = Instant::now();
     let high = smooth_mesh(&a.high)?;
     let low = smooth_mesh(&a.low)?;
-    let mut low_uv = with_atlas_uvs(&low, a.size).map_err(|e| anyhow::anyhow!("--size: {e}"))?;
+    let mut low_uv = with_atlas_uvs(&low, a.size).map_err(|e| {
+        // Say what would do: the smallest power of two whose atlas fits.
+        let fits = (7..=14).map(|k| 1u32 << k).find(|&s| s > a.size && with_atlas_uvs(&low, s).is_ok());
+        match fits {
+            Some(s) => anyhow::anyhow!("--size: {e} (use --size {s} or more)"),
+            None => anyhow::anyhow!("--size: {e} (even 16384 is too small: simplify the low mesh)"),
+        }
+    })?;
     low_uv.compute_tangents();
     let max_distance = a.max_distance * low.bounds().extent().length();
     eprintln!("Loaded {} and {} triangles in {:.2} s; baking {}² texels...", high.len(), low.len(), start.elapsed().as_secs_f64(), a.size);
@@ -65,13 +73,14 @@ pub fn run(a: &BakeArgs) -> Result<()> {
     Ok(())
 }
 
-/// Every mesh of an OBJ file as one, with angle-weighted normals unless it has its own (the
+/// Every mesh of a mesh file as one, with angle-weighted normals unless it has its own (the
 /// `smooth = true` of scene files, so the map matches what the renderer shades).
 fn smooth_mesh(path: &Path) -> Result<TriangleMesh> {
-    if !path.is_file() {
-        bail!("{}: cannot read: no such file", path.display());
-    }
-    let obj = load_obj(&Found::Disk(path.to_path_buf()), &Transform::IDENTITY)?;
+    // Found as scene files find meshes: the path itself, then `shared/scenes` of the current
+    // folder's ancestors (where the README's dragon lives); the error lists every path tried.
+    let name = path.to_string_lossy();
+    let found = Resolver::Disk { base: PathBuf::new() }.find(&name).map_err(|tried| anyhow::anyhow!("{}", not_found_message(&name, &tried)))?;
+    let obj = load_mesh_file(&found, &Transform::IDENTITY)?;
     let mut all = TriangleMesh { name: mesh_stem(path), ..Default::default() };
     let mut with_normals = true;
     for (mesh, _) in obj.meshes {
@@ -93,5 +102,5 @@ fn smooth_mesh(path: &Path) -> Result<TriangleMesh> {
 /// `dragon.obj.gz` → `dragon`.
 fn mesh_stem(path: &Path) -> String {
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    name.trim_end_matches(".gz").trim_end_matches(".obj").to_string()
+    name.trim_end_matches(".gz").trim_end_matches(".obj").trim_end_matches(".ply").to_string()
 }

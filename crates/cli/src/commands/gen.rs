@@ -20,12 +20,17 @@ pub struct GenArgs {
     /// Cubic curve segments per strand of `hair` (1-64)
     #[arg(long, default_value_t = 4)]
     pub segments: u32,
-    /// Scene file to write; a mesh (`.obj`) or curves (`.curves`) go beside it with the same stem
+    /// Scene file to write (.toml); a mesh (`.obj`) or curves (`.curves`) go beside it with the same stem
     #[arg(short, long)]
     pub output: PathBuf,
 }
 
 pub fn run(a: &GenArgs) -> Result<()> {
+    // The mesh or curves go beside the scene file under the same stem: `-o t.obj` would
+    // write the scene and then overwrite it with the mesh.
+    if a.output.extension().is_none_or(|e| e != "toml") {
+        anyhow::bail!("--output: the scene file must end in .toml (its mesh or curves are written beside it), found {}", a.output.display());
+    }
     let stem = a.output.file_stem().and_then(|s| s.to_str()).context("--output: needs a file name")?;
     let side_name = format!("{stem}.{}", if a.kind == "hair" { "curves" } else { "obj" });
     let size = raylab_procedural::Size { size: a.size, strands: a.strands, segments: a.segments };

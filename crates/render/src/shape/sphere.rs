@@ -32,7 +32,25 @@ impl Sphere {
 
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<f32> {
-        intersect::sphere(&self.object_ray(ray), self.center, self.radius)
+        let r = self.object_ray(ray);
+        let t = intersect::sphere(&r, self.center, self.radius)?;
+        // A root within its rounding error of 0 is the surface a spawned ray leaves, found
+        // again: shadow acne when the offset origin rounds to inside the sphere. pbrt-v4
+        // (§6.8.5) rejects a hit whose error interval contains 0; the near root is c / q
+        // with c = |o - centre|² - r², whose absolute error is within γ(|o - centre|² + r²),
+        // and |q| = |(o - centre)·d| + √disc, so `t_err` bounds its error (twice γ₉ for the
+        // transform into object space and the subtraction forming `o - centre`).
+        let oc = r.origin - self.center;
+        let half_b = oc.dot(r.dir);
+        let a = r.dir.length_squared();
+        let l = oc - (half_b / a) * r.dir;
+        let q = half_b.abs() + (a * (self.radius * self.radius - l.length_squared())).max(0.0).sqrt();
+        let t_err = 2.0 * raylab_core::gamma(9) * (oc.length_squared() + self.radius * self.radius) / q;
+        if t > t_err {
+            return Some(t);
+        }
+        // Keep looking beyond the error band (the far side of the sphere, for a ray that enters it).
+        intersect::sphere(&Ray { t_min: t_err.max(r.t_min), ..r }, self.center, self.radius)
     }
 
     /// Surface data at the hit distance `t`. UVs are longitude/latitude: `u` runs once

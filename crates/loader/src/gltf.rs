@@ -1,0 +1,166 @@
+//! The glTF 2.0 front end (`.gltf` with its `.bin`, and `.glb`), through the `gltf` crate:
+//! the default scene's node hierarchy and transforms, triangle meshes (positions, normals,
+//! first UV set), the metallic-roughness material mapped to raylab's materials (table in
+//! `docs/scene-format.md`), base-colour textures, perspective cameras and
+//! `KHR_lights_punctual`. Without a camera the model is framed as a bare mesh is.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use raylab_core::{Rgb, Transform, Vec2, Vec3};
+use raylab_render::bsdf::{Distribution, Geometry as MicrofacetGeometry};
+use raylab_render::material::TexColor;
+use raylab_render::texture::{Filter, ImageTexture, Wrap};
+use raylab_render::{Light, Material, MaterialId, Texture, TriangleMesh};
+
+use crate::description::{CameraDescription, SceneDescription, Span};
+use crate::error::LoadError;
+
+/// Reads a glTF or GLB file (and the buffers and images it names) into a description.
+pub fn parse_gltf(path: &Path) -> Result<SceneDescription, LoadError> {
+    let bytes = std::fs::read(path).map_err(|e| LoadError::file(path, format!("cannot read: {e}")))?;
+    let doc = gltf::Gltf::from_slice(&bytes).map_err(|e| LoadError::file(path, format!("not a valid glTF 2.0 file: {e}")))?;
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let read_uri = |what: &str, uri: &str| -> Result<Vec<u8>, LoadError> {
+        if uri.starts_with("data:") {
+            return Err(LoadError::new(path, None, what, "embedded data URIs are not supported: export as .glb or with a separate .bin"));
+        }
+        let file = base.join(uri.replace("%20", " "));
+        std::fs::read(&file).map_err(|e| LoadError::new(path, None, what, format!("{}: cannot read: {e}", file.display())))
+    };
+    let mut buffers = Vec::new();
+    for b in doc.buffers() {
+        buffers.push(match b.source() {
+            gltf::buffer::Source::Bin => doc.blob.clone().ok_or_else(|| LoadError::new(path, None, format!("buffers[{}]", b.index()), "the GLB has no binary chunk"))?,
+            gltf::buffer::Source::Uri(uri) => read_uri(&format!("buffers[{}]", b.index()), uri)?,
+        });
+    }
+
+    // Meshes and camera first; the description is made once the camera (or framing) is known.
+    let mut meshes: Vec<(TriangleMesh, Option<usize>)> = Vec::new();
+    let mut camera = None;
+    let mut lights = Vec::new();
+    let scene = doc.default_scene().or_else(|| doc.scenes().next()).ok_or_else(|| LoadError::file(path, "the file has no scene"))?;
+    let mut stack: Vec<(gltf::Node, glam::Mat4)> = scene.nodes().map(|n| (n, glam::Mat4::IDENTITY)).collect();
+    while let Some((node, parent)) = stack.pop() {
+        let world = parent * glam::Mat4::from_cols_array_2d(&node.transform().matrix());
+        let field = format!("nodes[{}]", node.index());
+        let to_world = Transform::from_affine(glam::Affine3A::from_mat4(world)).ok_or_else(|| LoadError::new(path, None, field.clone(), "the node's transform is singular"))?;
+        if let Some(mesh) = node.mesh() {
+            for prim in mesh.primitives() {
+                let pfield = format!("meshes[{}].primitives[{}]", mesh.index(), prim.index());
+                if prim.mode() != gltf::mesh::Mode::Triangles {
+                    return Err(LoadError::new(path, None, pfield, format!("mode {:?} is not supported (only triangles)", prim.mode())));
+                }
+                let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+                let positions: Vec<Vec3> = reader.read_positions().ok_or_else(|| LoadError::new(path, None, pfield.clone(), "has no POSITION"))?.map(|p| to_world.point(Vec3::from_array(p))).collect();
+                let indices: Vec<u32> = match reader.read_indices() {
+                    Some(i) => i.into_u32().collect(),
+                    None => (0..positions.len() as u32).collect(),
+                };
+                if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+                    return Err(LoadError::new(path, None, pfield, format!("index {bad} out of range ({} vertices)", positions.len())));
+                }
+                let normals = reader.read_normals().map(|n| n.map(|n| to_world.normal(Vec3::from_array(n)).normalize_or_zero()).collect()).unwrap_or_default();
+                let uvs = reader.read_tex_coords(0).map(|t| t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect()).unwrap_or_default();
+                let name = mesh.name().unwrap_or("gltf mesh").to_string();
+                let m = TriangleMesh { name, positions, normals, uvs, indices: indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(), object_to_world: to_world, ..Default::default() };
+                meshes.push((m, prim.material().index()));
+            }
+        }
+        if let (Some(cam), None) = (node.camera(), &camera) {
+            let gltf::camera::Projection::Perspective(p) = cam.projection() else {
+                return Err(LoadError::new(path, None, field, "orthographic cameras are not supported"));
+            };
+            // glTF cameras look down their local -z with +y up.
+            let from = world.transform_point3(Vec3::ZERO);
+            let span = Span::new(path, None, format!("cameras[{}]", cam.index()));
+            camera = Some(CameraDescription { from, at: from + world.transform_vector3(-Vec3::Z), up: world.transform_vector3(Vec3::Y), vfov: p.yfov().to_degrees(), aperture: 0.0, focus_distance: None, at_span: span.clone(), up_span: span });
+        }
+        if let Some(light) = node.light() {
+            let c = Rgb::from_array(light.color()) * light.intensity();
+            lights.push(match light.kind() {
+                // Candela (lm/sr) is an intensity per steradian: raylab's point intensity.
+                gltf::khr_lights_punctual::Kind::Point => Light::Point { position: world.transform_point3(Vec3::ZERO), intensity: c },
+                // Lux is an irradiance.
+                gltf::khr_lights_punctual::Kind::Directional => Light::Directional { direction: world.transform_vector3(-Vec3::Z).normalize(), irradiance: c },
+                gltf::khr_lights_punctual::Kind::Spot { .. } => return Err(LoadError::new(path, None, field, "spot lights are not supported (point and directional are)")),
+            });
+        }
+        stack.extend(node.children().map(|c| (c, world)));
+    }
+    if meshes.iter().all(|(m, _)| m.indices.is_empty()) {
+        return Err(LoadError::file(path, "the file has no triangles"));
+    }
+    let mut desc = match camera {
+        Some(c) => SceneDescription::new(path, c),
+        None => {
+            let only: Vec<TriangleMesh> = meshes.iter().map(|(m, _)| m.clone()).collect();
+            let mut d = crate::mesh_scene::framed_description(path, &only);
+            if !lights.is_empty() {
+                d.lights.clear();
+            }
+            d
+        }
+    };
+    desc.lights.extend(lights);
+
+    let mut material_ids: HashMap<usize, MaterialId> = HashMap::new();
+    for (mut mesh, mat) in meshes {
+        if let Some(k) = mat {
+            let id = match material_ids.get(&k) {
+                Some(&id) => id,
+                None => {
+                    let id = material(path, &doc, &buffers, &read_uri, k, &mut desc)?;
+                    material_ids.insert(k, id);
+                    id
+                }
+            };
+            mesh.emission = Rgb::from_array(doc.materials().nth(k).map_or([0.0; 3], |m| m.emissive_factor()));
+            mesh.material = id;
+        }
+        desc.geometry.add_mesh(mesh);
+    }
+    Ok(desc)
+}
+
+/// Maps a metallic-roughness material: a rough dielectric (metallic 0, roughness 1) is
+/// `diffuse`; anything else the glTF BRDF itself, `cooktorrance` with diffuse
+/// `base·(1 - metallic)`, `f0 = lerp(0.04, base, metallic)` and GGX α = roughness².
+fn material(path: &Path, doc: &gltf::Gltf, buffers: &[Vec<u8>], read_uri: &dyn Fn(&str, &str) -> Result<Vec<u8>, LoadError>, k: usize, desc: &mut SceneDescription) -> Result<MaterialId, LoadError> {
+    let m = doc.materials().nth(k).expect("index from the file");
+    let pbr = m.pbr_metallic_roughness();
+    let [r, g, b, _] = pbr.base_color_factor();
+    let base = Rgb::new(r, g, b);
+    let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
+    let field = format!("materials[{k}]");
+    let base_color = match pbr.base_color_texture() {
+        Some(info) => {
+            let image = info.texture().source();
+            let bytes = match image.source() {
+                gltf::image::Source::View { view, .. } => buffers[view.buffer().index()][view.offset()..view.offset() + view.length()].to_vec(),
+                gltf::image::Source::Uri { uri, .. } => read_uri(&field, uri)?,
+            };
+            let (w, h, texels) = crate::image_io::decode_image(path, &bytes, true).map_err(|e| LoadError::new(path, None, field.clone(), e.to_string()))?;
+            // The factor multiplies the texture; a white factor (the usual one) is the texture itself.
+            if base != Rgb::ONE {
+                desc.warnings.push(format!("{}: {field}: baseColorFactor {base} times a texture is read as the texture alone", path.display()));
+            }
+            let tex = ImageTexture::new(w, h, texels, Wrap::Repeat, Filter::Bilinear).map_err(|e| LoadError::new(path, None, field.clone(), e.to_string()))?;
+            TexColor::Texture(desc.add_texture(format!("{field}.baseColorTexture"), Texture::Image(tex)))
+        }
+        None => TexColor::Constant(base),
+    };
+    let material = if metallic == 0.0 && roughness >= 1.0 {
+        Material::Diffuse { albedo: base_color }
+    } else {
+        let diffuse = match base_color {
+            TexColor::Constant(c) => TexColor::Constant(c * (1.0 - metallic)),
+            t => t,
+        };
+        let f0 = Rgb::splat(0.04).lerp(base, metallic);
+        Material::CookTorrance { diffuse, specular: TexColor::Constant(Rgb::ONE), roughness: (roughness * roughness).max(1e-3), distribution: Distribution::Ggx, geometry: MicrofacetGeometry::Smith, f0: TexColor::Constant(f0) }
+    };
+    let name = m.name().map_or_else(|| field.clone(), str::to_string);
+    Ok(desc.add_material(name, material))
+}

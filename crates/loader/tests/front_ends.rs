@@ -1,0 +1,224 @@
+//! Every front end (TOML, bare OBJ/PLY, pbrt-v4) reads the same scene to the same image,
+//! from files written by an independent tool: `tests/data/bunny_*.ply` were exported from
+//! `assets/bunny_4968.obj` by trimesh 4.x (Python), the pbrt-v4 scenes written by hand.
+
+use std::path::{Path, PathBuf};
+
+use raylab_core::{Rgb, Vec3};
+use raylab_loader::{load_scene_or_mesh, load_scene_str, Overrides};
+use raylab_loader::files::Resolver;
+use raylab_render::{IntegratorKind, SamplerKind, Scene};
+
+fn data() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data")
+}
+
+fn pixels(scene: &Scene) -> Vec<Rgb> {
+    raylab_render::render(scene, &|_| {}).pixels
+}
+
+/// Mean squared error over pixels and channels.
+fn mse(a: &[Rgb], b: &[Rgb]) -> f32 {
+    assert_eq!(a.len(), b.len());
+    a.iter().zip(b).map(|(x, y)| (*x - *y).length_squared() / 3.0).sum::<f32>() / a.len() as f32
+}
+
+fn mean(a: &[Rgb]) -> f32 {
+    a.iter().map(|p| (p.x + p.y + p.z) / 3.0).sum::<f32>() / a.len() as f32
+}
+
+/// `tests/data/bunny.toml` with its mesh file replaced.
+fn toml_with_mesh(file: &str) -> Scene {
+    let src = std::fs::read_to_string(data().join("bunny.toml")).unwrap().replace("bunny_binary.ply", file);
+    load_scene_str(&src, &data().join("bunny.toml"), &Resolver::Disk { base: data() }, &Overrides::default()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn toml_obj_ply_and_pbrt_render_the_same_image() {
+    // The reference: the OBJ trimesh read, found on the shared scene path.
+    let reference = toml_with_mesh("bunny_4968.obj");
+    assert_eq!(reference.geometry.triangle_count(), 4968 + 2);
+    let reference_px = pixels(&reference);
+    // Not a black image: the comparison below would pass trivially.
+    assert!(mean(&reference_px) > 0.05, "mean {}", mean(&reference_px));
+    let pbrt = load_scene_or_mesh(&data().join("bunny.pbrt"), &Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
+    for (name, scene) in [("TOML + binary PLY", toml_with_mesh("bunny_binary.ply")), ("TOML + gzipped ASCII PLY", toml_with_mesh("bunny_ascii.ply.gz")), ("pbrt-v4", pbrt)] {
+        assert_eq!(scene.geometry.triangle_count(), reference.geometry.triangle_count(), "{name}");
+        assert_eq!((scene.settings.width, scene.settings.height, scene.settings.spp, scene.settings.max_depth), (64, 48, 4, 2), "{name}");
+        assert_eq!((scene.settings.sampler, scene.settings.integrator), (SamplerKind::Random, IntegratorKind::Path), "{name}");
+        // Same camera rays and samples, so only the vertex normals (trimesh recomputes
+        // them, within 1e-3 of the OBJ's) make pixels differ.
+        let e = mse(&reference_px, &pixels(&scene));
+        assert!(e < 1e-4, "{name}: MSE {e} against the OBJ");
+    }
+}
+
+#[test]
+fn bare_obj_and_ply_are_framed_alike() {
+    let obj = load_scene_or_mesh(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/bunny_4968.obj"), &Overrides { width: Some(48), height: Some(36), ..Default::default() }).unwrap();
+    let ply = load_scene_or_mesh(&data().join("bunny_binary.ply"), &Overrides { width: Some(48), height: Some(36), ..Default::default() }).unwrap();
+    assert_eq!(obj.geometry.triangle_count(), 4968);
+    assert_eq!(ply.geometry.triangle_count(), 4968);
+    assert_eq!(obj.camera.from, ply.camera.from);
+    let (a, b) = (pixels(&obj), pixels(&ply));
+    // The bunny covers about a fifth of the frame, on black.
+    assert!(mean(&a) > 0.004, "mean {}", mean(&a));
+    assert!(mse(&a, &b) < 1e-4, "MSE {}", mse(&a, &b));
+}
+
+#[test]
+fn a_pbrt_scene_using_every_directive_of_the_subset() {
+    let s = load_scene_or_mesh(&data().join("every_directive.pbrt"), &Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
+    // Film, Sampler and Integrator: zsobol -> sobol, maxdepth 3 bounces = 4 segments.
+    assert_eq!((s.settings.width, s.settings.height, s.settings.spp), (48, 64, 8));
+    assert_eq!((s.settings.sampler, s.settings.integrator, s.settings.max_depth), (SamplerKind::Sobol, IntegratorKind::Path, 4));
+    // fov 40 is that of the shorter (horizontal) side: vfov = 2 atan(tan 20° · 64/48).
+    let vfov = 2.0 * (20f32.to_radians().tan() * 64.0 / 48.0).atan().to_degrees();
+    assert!((s.camera.vfov - vfov).abs() < 1e-3, "{} vs {vfov}", s.camera.vfov);
+    assert_eq!(s.camera.from, Vec3::new(0.0, 1.0, 6.0));
+    // Two spheres; the floor (2) + the textured quad (2) + the light (2) + the PLY bunny.
+    assert_eq!(s.geometry.spheres.len(), 2);
+    assert_eq!(s.geometry.triangle_count(), 2 + 2 + 2 + 4968);
+    // Lights: the point light (I · scale) and the distant one; the area light emits 4.
+    assert_eq!(s.lights.len(), 2);
+    assert!(s.lights.iter().any(|l| matches!(l, raylab_render::Light::Point { intensity, .. } if *intensity == Rgb::splat(10.0))));
+    assert_eq!(s.area_lights.len(), 2);
+    assert!(s.environment.is_some());
+    // Named materials, the coated diffuse and the MTL-free default: names are kept.
+    assert!(s.material_names.iter().any(|n| n == "gold") && s.material_names.iter().any(|n| n == "glass"));
+    assert_eq!(s.textures.len(), 2);
+    // It renders, and not to black.
+    let small = load_scene_or_mesh(&data().join("every_directive.pbrt"), &Overrides { width: Some(24), height: Some(32), spp: Some(4), ..Default::default() }).unwrap();
+    assert!(mean(&pixels(&small)) > 0.01);
+}
+
+/// pbrt's camera space is left-handed: a plain LookAt shows the world mirrored compared
+/// with raylab's camera, so the loader mirrors the world to give pbrt's image.
+#[test]
+fn a_plain_pbrt_look_at_gives_pbrts_image_not_its_mirror() {
+    let dir = std::env::temp_dir().join(format!("raylab_pbrt_mirror_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = |prefix: &str| {
+        let path = dir.join("s.pbrt");
+        std::fs::write(&path, format!("{prefix}LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\nTranslate -1 0 0\nShape \"sphere\" \"float radius\" 0.5\n")).unwrap();
+        load_scene_or_mesh(&path, &Overrides::default()).unwrap()
+    };
+    // pbrt's image x axis is up × forward = Y × -Z = -X: the sphere at x = -1 is on the
+    // right of pbrt's image, so on raylab's right (+x seen from +z) after the mirror.
+    let plain = scene("");
+    assert!(plain.geometry.spheres[0].bounds().centroid().x > 0.9, "{:?}", plain.geometry.spheres[0].bounds());
+    // With `Scale -1 1 1` (Blender's exporter) pbrt's camera is right-handed: no mirror.
+    let exported = scene("Scale -1 1 1\n");
+    assert!(exported.geometry.spheres[0].bounds().centroid().x < -0.9);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+fn pbrt_error(src: &str, lenient: bool) -> Result<Vec<String>, String> {
+    let dir = std::env::temp_dir().join(format!("raylab_pbrt_err_{}_{}", std::process::id(), src.len()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.pbrt");
+    std::fs::write(&path, src).unwrap();
+    let r = raylab_loader::parse_any(&path, lenient).map(|d| d.warnings).map_err(|e| e.to_string().replace(&dir.display().to_string(), "DIR"));
+    std::fs::remove_dir_all(&dir).ok();
+    r.map(|w| w.into_iter().map(|s| s.replace(&dir.display().to_string(), "DIR")).collect())
+}
+
+const CAMERA: &str = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n";
+
+#[test]
+fn pbrt_outside_the_subset_is_an_error_naming_file_line_and_directive() {
+    let src = format!("{CAMERA}MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nShape \"sphere\"\n");
+    assert_eq!(
+        pbrt_error(&src, false).unwrap_err(),
+        format!("DIR/bad.pbrt:4: MakeNamedMedium: unknown or unsupported directive `MakeNamedMedium` (supported: LookAt, Camera, Film, Sampler, Integrator, WorldBegin, Identity, Translate, Rotate, Scale, Transform, ConcatTransform, AttributeBegin, AttributeEnd, Include, Import, Shape, Material, MakeNamedMaterial, NamedMaterial, Texture, LightSource, AreaLightSource) (raylab reads a subset of pbrt-v4; see docs/scene-format.md)")
+    );
+    // --lenient: a warning, and the rest is read.
+    let warnings = pbrt_error(&src, true).unwrap();
+    assert_eq!(warnings.len(), 1);
+    assert!(warnings[0].starts_with("DIR/bad.pbrt:4: MakeNamedMedium: unknown or unsupported directive") && warnings[0].ends_with("; skipped"), "{}", warnings[0]);
+    assert_eq!(
+        pbrt_error(&format!("{CAMERA}Shape \"curve\" \"point3 P\" [ 0 0 0 1 1 1 2 2 2 3 3 3 ]\n"), false).unwrap_err(),
+        "DIR/bad.pbrt:4: Shape: shape \"curve\" is not supported (supported: trianglemesh, plymesh, sphere, bilinearmesh) (raylab reads a subset of pbrt-v4; see docs/scene-format.md)"
+    );
+    assert_eq!(
+        pbrt_error(&format!("{CAMERA}Shape \"sphere\" \"float radius\" 1 \"float zmin\" -0.5\n"), false).unwrap_err(),
+        "DIR/bad.pbrt:4: Shape: parameter \"float zmin\" is not supported (raylab reads a subset of pbrt-v4; see docs/scene-format.md)"
+    );
+    assert_eq!(pbrt_error(&format!("{CAMERA}\nTranslate 1 2\n"), false).unwrap_err(), "DIR/bad.pbrt:5: Translate: expected 3 numbers, found 2");
+    assert_eq!(pbrt_error(&format!("{CAMERA}Include \"nowhere.pbrt\"\n"), false).unwrap_err().split(" (looked in").next().unwrap(), "DIR/bad.pbrt:4: Include: cannot find `nowhere.pbrt`");
+    assert_eq!(pbrt_error("WorldBegin\n", false).unwrap_err(), "DIR/bad.pbrt: no `Camera` directive before `WorldBegin` (raylab needs one)");
+}
+
+#[test]
+fn unknown_extensions_and_empty_meshes_are_errors() {
+    let e = load_scene_or_mesh(Path::new("scene.xml"), &Overrides::default()).unwrap_err().to_string();
+    assert_eq!(e, "scene.xml: unsupported file type (supported: .toml, .pbrt, .gltf, .glb, .obj, .obj.gz, .ply, .ply.gz)");
+    let src = "[camera]\nfrom = [0, 0, 5]\nat = [0, 0, 0]\nvfov = 40\n[[shapes]]\ntype = \"mesh\"\nfile = \"bunny.stl\"\n";
+    let e = load_scene_str(src, Path::new("s.toml"), &Resolver::Disk { base: data() }, &Overrides::default()).unwrap_err().to_string();
+    assert_eq!(e, "s.toml:7: shapes[0].file: unsupported mesh format `bunny.stl` (supported: .obj, .obj.gz, .ply, .ply.gz)");
+    // A PLY with vertices and no faces loads 0 triangles: an error, not a black image.
+    let dir = std::env::temp_dir().join(format!("raylab_empty_ply_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let ply = dir.join("empty.ply");
+    std::fs::write(&ply, "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n").unwrap();
+    let e = load_scene_or_mesh(&ply, &Overrides::default()).unwrap_err().to_string();
+    assert_eq!(e, format!("{}: the mesh has no triangles", ply.display()));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_bare_glb_from_trimesh_is_framed_like_the_obj() {
+    let o = Overrides { width: Some(48), height: Some(36), ..Default::default() };
+    let obj = load_scene_or_mesh(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/bunny_4968.obj"), &o).unwrap();
+    let glb = load_scene_or_mesh(&data().join("bunny.glb"), &o).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(glb.geometry.triangle_count(), 4968);
+    assert!((glb.camera.from - obj.camera.from).length() < 1e-5, "{} vs {}", glb.camera.from, obj.camera.from);
+    let e = mse(&pixels(&obj), &pixels(&glb));
+    assert!(e < 1e-4, "MSE {e}");
+}
+
+/// A hand-written glTF: node transforms, a camera, a KHR point light and a metallic material.
+#[test]
+fn gltf_nodes_camera_light_and_material_map_as_documented() {
+    let dir = std::env::temp_dir().join(format!("raylab_gltf_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bin: Vec<u8> = [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(dir.join("tri.bin"), &bin).unwrap();
+    let json = r#"{
+      "asset": {"version": "2.0"},
+      "extensionsUsed": ["KHR_lights_punctual"],
+      "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "color": [1, 0.5, 0.25], "intensity": 10}]}},
+      "scene": 0,
+      "scenes": [{"nodes": [0, 1, 2]}],
+      "nodes": [
+        {"mesh": 0, "translation": [1, 0, 0], "scale": [2, 2, 2]},
+        {"camera": 0, "translation": [0, 0, 5]},
+        {"translation": [0, 3, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}}
+      ],
+      "cameras": [{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
+      "materials": [{"name": "gold-ish", "pbrMetallicRoughness": {"baseColorFactor": [1, 0.8, 0.4, 1], "metallicFactor": 1, "roughnessFactor": 0.5}}],
+      "buffers": [{"uri": "tri.bin", "byteLength": 36}],
+      "bufferViews": [{"buffer": 0, "byteLength": 36}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}]
+    }"#;
+    std::fs::write(dir.join("tri.gltf"), json).unwrap();
+    let s = load_scene_or_mesh(&dir.join("tri.gltf"), &Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(s.geometry.meshes[0].positions, vec![Vec3::new(1.0, 0.0, 0.0), Vec3::new(3.0, 0.0, 0.0), Vec3::new(1.0, 2.0, 0.0)]);
+    assert_eq!(s.camera.from, Vec3::new(0.0, 0.0, 5.0));
+    assert!((s.camera.vfov - 0.5f32.to_degrees()).abs() < 1e-4);
+    assert_eq!(s.lights.len(), 1);
+    assert!(matches!(s.lights[0], raylab_render::Light::Point { position, intensity } if position == Vec3::new(0.0, 3.0, 0.0) && intensity == Rgb::new(10.0, 5.0, 2.5)));
+    let m = s.geometry.meshes[0].material;
+    assert_eq!(s.material_names[m.0 as usize], "gold-ish");
+    // Fully metallic: no diffuse, f0 = base colour, α = roughness².
+    match &s.materials[m.0 as usize] {
+        raylab_render::Material::CookTorrance { diffuse, f0, roughness, .. } => {
+            assert_eq!(*diffuse, raylab_render::material::TexColor::Constant(Rgb::ZERO));
+            assert_eq!(*f0, raylab_render::material::TexColor::Constant(Rgb::new(1.0, 0.8, 0.4)));
+            assert_eq!(*roughness, 0.25);
+        }
+        other => panic!("{other:?}"),
+    }
+}
