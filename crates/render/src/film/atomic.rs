@@ -25,8 +25,8 @@ pub fn parent_dir(path: &Path) -> &Path {
 }
 
 /// Writes `bytes` to `path` atomically (see the module documentation).
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    write_atomic_with(path, |f| f.write_all(bytes))
+pub fn write_atomic(path: impl AsRef<Path>, bytes: impl AsRef<[u8]>) -> std::io::Result<()> {
+    write_atomic_with(path.as_ref(), |f| f.write_all(bytes.as_ref()))
 }
 
 /// Like [`write_atomic`], the content produced by `fill` into the temporary file.
