@@ -284,13 +284,15 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             write_film(c, &film)?;
         }
         let held = film.samples();
-        let have_samples = !held.is_empty();
-        match kind {
-            OutputKind::Film => write_film(&out, &film)?,
-            OutputKind::Image if have_samples => {
-                image_io::write_image(&out, crop.width(), crop.height(), &film.resolve(), a.tonemap, a.exposure)?;
+        // A stopped render still writes its image (of the samples it holds). A partial film
+        // goes to -o only if there is no checkpoint to hold it: with one, -o PART.film
+        // appears only once complete, so job scripts can take its existence for "done".
+        let written = !held.is_empty() && (kind == OutputKind::Image || stop == Stop::Done || a.checkpoint.is_none());
+        if written {
+            match kind {
+                OutputKind::Film => write_film(&out, &film)?,
+                OutputKind::Image => image_io::write_image(&out, crop.width(), crop.height(), &film.resolve(), a.tonemap, a.exposure)?,
             }
-            OutputKind::Image => {}
         }
         let stopped = match stop {
             Stop::Done => "done",
@@ -322,8 +324,10 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             };
             println!("{}", serde_json::to_string_pretty(&summary)?);
         }
-        let wrote = if !have_samples {
+        let wrote = if held.is_empty() {
             "no pass completed, nothing written".to_string()
+        } else if !written {
+            format!("{} will be written when complete (samples {}..{} of {} held)", out.display(), held.start, held.end, s.spp)
         } else if held.len() as u32 == s.spp {
             format!("Wrote {}", out.display())
         } else {
