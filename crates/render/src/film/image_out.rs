@@ -164,7 +164,9 @@ pub fn encode_image(path: &Path, width: u32, height: u32, pixels: &[Rgb], tonema
                 (exposed(p.x, scale), exposed(p.y, scale), exposed(p.z, scale))
             });
             let mut out = std::io::Cursor::new(Vec::new());
-            Image::from_channels((width as usize, height as usize), channels).write().to_buffered(&mut out).map_err(|e| err(path, format!("cannot encode OpenEXR: {e}")))?;
+            // Sequential: the parallel writer stores chunks in completion order, so the same
+            // pixels would give different bytes from run to run.
+            Image::from_channels((width as usize, height as usize), channels).write().non_parallel().to_buffered(&mut out).map_err(|e| err(path, format!("cannot encode OpenEXR: {e}")))?;
             out.into_inner()
         }
         other => return Err(err(path, format!("unknown image format `.{other}` (valid: {})", image_format_names()))),
@@ -195,6 +197,17 @@ mod tests {
     fn ppm_header_is_the_seeds_p6() {
         let bytes = encode_image(Path::new("t.ppm"), 2, 1, &[Rgb::ONE, Rgb::ZERO], Tonemap::Clamp, 0.0).unwrap();
         assert_eq!(bytes, b"P6\n2 1\n255\n\xff\xff\xff\x00\x00\x00");
+    }
+
+    #[test]
+    fn exr_bytes_are_the_same_every_time() {
+        // Many chunks of noise: a writer that emits chunks in completion order would differ.
+        let (w, h) = (97, 301);
+        let pixels: Vec<Rgb> = (0..w * h).map(|i| Rgb::new((i as f32 * 0.618).fract(), (i as f32 * 0.414).fract(), i as f32)).collect();
+        let first = encode_image(Path::new("t.exr"), w, h, &pixels, Tonemap::Clamp, 0.0).unwrap();
+        for _ in 0..8 {
+            assert!(encode_image(Path::new("t.exr"), w, h, &pixels, Tonemap::Clamp, 0.0).unwrap() == first);
+        }
     }
 
     #[test]
