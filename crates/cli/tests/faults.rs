@@ -228,3 +228,23 @@ fn a_time_limit_writes_a_valid_image_of_the_passes_that_fit() {
     assert!(pixels.iter().any(|p| p.max_element() > 0.0));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_second_sigint_exits_at_once() {
+    let dir = scratch("twice");
+    let scene = cornell();
+    // One pass of 65536 samples: after the first SIGINT the tile in flight still takes many
+    // seconds to finish; the second SIGINT must not wait for it.
+    let mut child = spawn(&["render", &scene, "--width", "32", "--height", "32", "--spp", "65536", "--pass-spp", "65536", "--threads", "1", "-q", "-o", "x.png"], &dir);
+    std::thread::sleep(Duration::from_millis(1500));
+    signal(&child, "INT");
+    std::thread::sleep(Duration::from_millis(300));
+    assert!(child.try_wait().unwrap().is_none(), "the first SIGINT lets the tile in flight finish");
+    signal(&child, "INT");
+    let start = Instant::now();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130));
+    assert!(start.elapsed() < Duration::from_secs(3), "took {:?}", start.elapsed());
+    assert!(!dir.join("x.png").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
