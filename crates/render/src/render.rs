@@ -205,10 +205,14 @@ fn pixel_sums(scene: &Scene, x: u32, y: u32, samples: Range<u32>, c: &mut Counte
 pub fn render(scene: &Scene, progress: &(dyn Fn(u64) + Sync)) -> RenderOutput {
     let s = &scene.settings;
     let start = Instant::now();
-    let mut film = Film::new(film_header(scene, DEFAULT_PASS_SAMPLES), Crop::full(s.width, s.height)).expect("the loader validates the image size and spp");
+    let empty = || RenderOutput { width: s.width, height: s.height, pixels: vec![Rgb::ZERO; s.width as usize * s.height as usize], counters: Counters::default(), nonfinite_samples: 0, seconds: 0.0 };
+    // An empty image or no samples (settings the loader never produces): nothing to render.
+    let Ok(mut film) = Film::new(film_header(scene, DEFAULT_PASS_SAMPLES), Crop::full(s.width, s.height)) else { return empty() };
     let never = AtomicBool::new(false);
     let control = Control { cancel: &never, deadline: None, progress };
-    render_tile(scene, &mut film, 0..s.spp, &control, |_| Ok::<(), FilmError>(())).expect("a new film takes every pass of the scene's samples");
+    if render_tile(scene, &mut film, 0..s.spp, &control, |_| Ok::<(), FilmError>(())).is_err() {
+        return empty();
+    }
     let seconds = start.elapsed().as_secs_f64();
     RenderOutput { width: s.width, height: s.height, pixels: film.resolve(), counters: film.counters, nonfinite_samples: film.nonfinite_samples, seconds }
 }

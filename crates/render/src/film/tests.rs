@@ -196,3 +196,11 @@ fn corrupt_film_files_are_refused_without_allocating() {
     old[8] = 9;
     assert_eq!(e(&old), "not a raylab film: film format version 9, this raylab reads version 1");
 }
+
+#[test]
+fn the_plain_render_of_no_samples_is_black_not_a_panic() {
+    let mut scene = scene();
+    scene.settings.spp = 0;
+    let out = crate::render(&scene, &|_| {});
+    assert_eq!(out.pixels, vec![Rgb::ZERO; 37 * 21]);
+}
