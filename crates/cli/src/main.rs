@@ -33,6 +33,8 @@ enum Command {
     Gen(commands::gen::GenArgs),
     /// Bake a high-resolution mesh's normals into a normal map on a low-resolution one
     Bake(commands::bake::BakeArgs),
+    /// Join the films of tiles and sample ranges (render --tile/--crop/--samples) into one image
+    Merge(commands::merge::MergeArgs),
 }
 
 fn main() -> ExitCode {
@@ -47,9 +49,16 @@ fn main() -> ExitCode {
         Some(Command::Compare(a)) => commands::compare::run(&a),
         Some(Command::Converge(a)) => commands::converge::run(&a),
         Some(Command::Bake(a)) => commands::bake::run(&a),
+        Some(Command::Merge(a)) => commands::merge::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // A render stopped by SIGINT/SIGTERM after saving its work: 130/143, as shells expect.
+        Err(e) if e.downcast_ref::<commands::render::Interrupted>().is_some() => {
+            let i = e.downcast_ref::<commands::render::Interrupted>().unwrap();
+            eprintln!("raylab: error: {i}");
+            ExitCode::from(i.code)
+        }
         Err(e) => {
             eprintln!("raylab: error: {e:#}");
             ExitCode::FAILURE

@@ -104,7 +104,7 @@ fn bad_input_fails_with_file_line_and_field() {
     write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
     fails_with(&["render", "bad.obj"], &dir, "bad.obj:4: face index 4 is out of range: the file has 3 vertex (`v`) entries");
     fails_with(&["render", "absent.toml"], &dir, "absent.toml: cannot read: No such file or directory (os error 2)");
-    fails_with(&["render", "-o", "out.bmp"], &dir, "out.bmp: unknown image format `.bmp` (valid: png, ppm, exr, pfm)");
+    fails_with(&["render", "-o", "out.bmp"], &dir, "out.bmp: unknown output format `.bmp` (valid: png, ppm, exr, pfm, film)");
     fails_with(
         &["render", "--accel", "octree"],
         &dir,

@@ -1,7 +1,7 @@
 //! The ray-file format shared with other libraries: little endian, a `u64` count, then
 //! `count` rays of 8 `f32`: `ox oy oz tmin dx dy dz tmax`.
 
-use std::io::{Read, Write};
+use std::io::Read;
 use std::path::Path;
 
 use raylab_core::{Ray, Vec3};
@@ -24,7 +24,7 @@ pub fn write(path: &Path, rays: &[Ray]) -> Result<(), RayFileError> {
             bytes.extend_from_slice(&v.to_le_bytes());
         }
     }
-    std::fs::File::create(path).and_then(|mut f| f.write_all(&bytes)).map_err(|e| err(path, format!("cannot write: {e}")))
+    raylab_render::film::atomic::write_atomic(path, &bytes).map_err(|e| err(path, format!("cannot write: {e}")))
 }
 
 pub fn read(path: &Path) -> Result<Vec<Ray>, RayFileError> {

@@ -1,86 +1,19 @@
-//! Reading textures and writing rendered images: PNG/JPEG (8-bit sRGB, via `image`),
-//! OpenEXR (linear half/float, via `exr`), PFM (linear float) and PPM (binary P6, the
-//! seeds' output format). Every error starts with the path.
+//! Reading images (textures, references): PNG/JPEG (8-bit sRGB, via `image`), OpenEXR
+//! (linear half/float, via `exr`), PFM (linear float) and PPM (binary P6). Every error
+//! starts with the path. Writing lives beside the film, re-exported here.
 
-use std::fmt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::str::FromStr;
 
-use raylab_core::color::{linear_to_srgb8, srgb_to_linear};
+use raylab_core::color::srgb_to_linear;
 use raylab_core::Rgb;
 
-/// Formats `write_image` can produce, for messages.
-pub fn image_format_names() -> &'static str {
-    "png, ppm, exr, pfm"
-}
-
-/// An image that could not be read or written.
-#[derive(Debug, thiserror::Error)]
-#[error("{}: {message}", path.display())]
-pub struct ImageError {
-    pub path: PathBuf,
-    pub message: String,
-}
+// Tone mapping and image writing moved beside the film (`raylab_render::film::image_out`);
+// re-exported here so that existing callers keep compiling.
+pub use raylab_render::film::image_out::{encode_image, encode_png, image_format_names, write_image, write_linear_png, ImageError, Tonemap, UnknownTonemap};
 
 fn err(path: &Path, message: impl Into<String>) -> ImageError {
     ImageError { path: path.to_path_buf(), message: message.into() }
-}
-
-/// How linear radiance becomes a displayable value in [0, 1] before sRGB encoding.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Tonemap {
-    /// Clip at 1 (the classic ray tracer's behaviour).
-    #[default]
-    Clamp,
-    /// `c / (1 + c)` per channel (Reinhard et al. 2002, simple form).
-    Reinhard,
-    /// Narkowicz's fit of the ACES filmic curve.
-    Aces,
-}
-
-impl Tonemap {
-    pub const ALL: [Tonemap; 3] = [Tonemap::Clamp, Tonemap::Reinhard, Tonemap::Aces];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Tonemap::Clamp => "clamp",
-            Tonemap::Reinhard => "reinhard",
-            Tonemap::Aces => "aces",
-        }
-    }
-
-    /// Maps one linear channel, scaled by `2^exposure`, into [0, 1]. Non-finite values give 0.
-    pub fn apply(self, v: f32, exposure: f32) -> f32 {
-        let v = v * exposure.exp2();
-        if !v.is_finite() || v <= 0.0 {
-            return 0.0;
-        }
-        match self {
-            Tonemap::Clamp => v.min(1.0),
-            Tonemap::Reinhard => v / (1.0 + v),
-            Tonemap::Aces => ((v * (2.51 * v + 0.03)) / (v * (2.43 * v + 0.59) + 0.14)).clamp(0.0, 1.0),
-        }
-    }
-}
-
-/// An unknown tone-map name.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct UnknownTonemap(pub String);
-
-impl fmt::Display for UnknownTonemap {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let names: Vec<_> = Tonemap::ALL.iter().map(|t| t.name()).collect();
-        write!(f, "unknown tone map `{}` (valid: {})", self.0, names.join(", "))
-    }
-}
-
-impl std::error::Error for UnknownTonemap {}
-
-impl FromStr for Tonemap {
-    type Err = UnknownTonemap;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Tonemap::ALL.into_iter().find(|t| t.name() == s).ok_or_else(|| UnknownTonemap(s.to_string()))
-    }
 }
 
 fn extension(path: &Path) -> String {
@@ -227,71 +160,6 @@ fn read_ppm(path: &Path, bytes: &[u8], srgb: bool) -> Result<(u32, u32, Vec<Rgb>
     Ok((w, h, pixels))
 }
 
-/// 8-bit sRGB bytes (RGB interleaved) after exposure and tone map.
-fn to_srgb8(pixels: &[Rgb], tonemap: Tonemap, exposure: f32) -> Vec<u8> {
-    pixels.iter().flat_map(|p| [p.x, p.y, p.z]).map(|v| linear_to_srgb8(tonemap.apply(v, exposure))).collect()
-}
-
-/// Encodes an image as PNG bytes (8-bit sRGB).
-pub fn encode_png(width: u32, height: u32, pixels: &[Rgb], tonemap: Tonemap, exposure: f32) -> Result<Vec<u8>, ImageError> {
-    let path = Path::new("<png>");
-    let mut out = Vec::new();
-    let encoder = image::codecs::png::PngEncoder::new(&mut out);
-    image::ImageEncoder::write_image(encoder, &to_srgb8(pixels, tonemap, exposure), width, height, image::ExtendedColorType::Rgb8)
-        .map_err(|e| err(path, format!("cannot encode PNG: {e}")))?;
-    Ok(out)
-}
-
-/// Writes an image; the extension picks the format. PNG and PPM get exposure, tone map and
-/// sRGB encoding; EXR and PFM keep linear radiance (exposure still scales it).
-pub fn write_image(path: &Path, width: u32, height: u32, pixels: &[Rgb], tonemap: Tonemap, exposure: f32) -> Result<(), ImageError> {
-    assert_eq!(pixels.len(), width as usize * height as usize, "pixel count must match the size");
-    let bytes = match extension(path).as_str() {
-        "png" => encode_png(width, height, pixels, tonemap, exposure).map_err(|e| err(path, e.message))?,
-        "ppm" => {
-            let mut out = format!("P6\n{width} {height}\n255\n").into_bytes();
-            out.extend(to_srgb8(pixels, tonemap, exposure));
-            out
-        }
-        "pfm" => {
-            let mut out = format!("PF\n{width} {height}\n-1.0\n").into_bytes();
-            let scale = exposure.exp2();
-            for row in pixels.chunks(width as usize).rev() {
-                for p in row {
-                    for v in [p.x, p.y, p.z] {
-                        out.extend((finite_or_zero(v) * scale).to_le_bytes());
-                    }
-                }
-            }
-            out
-        }
-        "exr" => return write_exr(path, width, height, pixels, exposure),
-        other => return Err(err(path, format!("unknown image format `.{other}` (valid: {})", image_format_names()))),
-    };
-    std::fs::write(path, bytes).map_err(|e| err(path, format!("cannot write: {e}")))
-}
-
-/// Writes 8-bit PNG values `round(255 · v)` with no tone map and no sRGB curve: for data
-/// such as normal maps, read back with `srgb = false`.
-pub fn write_linear_png(path: &Path, width: u32, height: u32, pixels: &[Rgb]) -> Result<(), ImageError> {
-    assert_eq!(pixels.len(), width as usize * height as usize, "pixel count must match the size");
-    let bytes: Vec<u8> = pixels.iter().flat_map(|p| [p.x, p.y, p.z]).map(|v| (finite_or_zero(v).clamp(0.0, 1.0) * 255.0).round() as u8).collect();
-    image::save_buffer(path, &bytes, width, height, image::ExtendedColorType::Rgb8).map_err(|e| err(path, format!("cannot write PNG: {e}")))
-}
-
-fn finite_or_zero(v: f32) -> f32 {
-    if v.is_finite() { v } else { 0.0 }
-}
-
-fn write_exr(path: &Path, width: u32, height: u32, pixels: &[Rgb], exposure: f32) -> Result<(), ImageError> {
-    let scale = exposure.exp2();
-    exr::prelude::write_rgb_file(path, width as usize, height as usize, |x, y| {
-        let p = pixels[y * width as usize + x];
-        (finite_or_zero(p.x) * scale, finite_or_zero(p.y) * scale, finite_or_zero(p.z) * scale)
-    })
-    .map_err(|e| err(path, format!("cannot write OpenEXR: {e}")))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -344,15 +212,6 @@ mod tests {
     }
 
     #[test]
-    fn ppm_header_is_the_seeds_p6() {
-        let dir = std::env::temp_dir().join(format!("raylab-image-ppm-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("t.ppm");
-        write_image(&path, 2, 1, &[Rgb::ONE, Rgb::ZERO], Tonemap::Clamp, 0.0).unwrap();
-        assert_eq!(std::fs::read(&path).unwrap(), b"P6\n2 1\n255\n\xff\xff\xff\x00\x00\x00");
-    }
-
-    #[test]
     fn errors_name_the_file() {
         let e = write_image(Path::new("out.bmp"), 1, 1, &[Rgb::ONE], Tonemap::Clamp, 0.0).unwrap_err();
         assert_eq!(e.to_string(), "out.bmp: unknown image format `.bmp` (valid: png, ppm, exr, pfm)");
@@ -365,21 +224,5 @@ mod tests {
         let nan = [b"PF\n1 1\n-1\n".as_slice(), &f32::NAN.to_le_bytes().repeat(3)].concat();
         let e = decode_image(Path::new("x.pfm"), &nan, false).unwrap_err();
         assert_eq!(e.to_string(), "x.pfm: pixel (0, 0) is not a finite number");
-    }
-
-    #[test]
-    fn tonemaps_are_monotone_and_bounded() {
-        for t in Tonemap::ALL {
-            assert_eq!(t.name().parse::<Tonemap>().unwrap(), t);
-            let mut last = 0.0;
-            for i in 0..1000 {
-                let v = t.apply(i as f32 * 0.05, 0.0);
-                assert!((0.0..=1.0).contains(&v) && v >= last, "{t:?}");
-                last = v;
-            }
-            assert_eq!(t.apply(f32::NAN, 0.0), 0.0);
-        }
-        assert_eq!(Tonemap::Clamp.apply(0.25, 1.0), 0.5);
-        assert_eq!("gamma".parse::<Tonemap>().unwrap_err().to_string(), "unknown tone map `gamma` (valid: clamp, reinhard, aces)");
     }
 }

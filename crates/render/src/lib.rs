@@ -5,6 +5,7 @@
 pub mod bsdf;
 pub mod camera;
 pub mod filter;
+pub mod film;
 pub mod integrator;
 pub mod light;
 pub mod material;
@@ -19,7 +20,8 @@ pub use camera::Camera;
 pub use integrator::IntegratorKind;
 pub use light::Light;
 pub use material::{Material, MaterialId, TexColor, TextureId};
-pub use render::{render, RenderOutput};
+pub use film::{Crop, Film, FilmError, FilmHeader};
+pub use render::{render, render_tile, Control, RenderOutput, Stop};
 pub use sampler::{PixelSampler, SamplerKind};
 pub use scene::{Background, RenderSettings, Scene, SurfaceHit};
 pub use shape::{Geometry, Sphere, TriangleMesh};

@@ -62,7 +62,7 @@ pub fn run(a: &BakeArgs) -> Result<()> {
     let bake_seconds = bake_start.elapsed().as_secs_f64();
     write_linear_png(&a.output, a.size, a.size, &map.texels)?;
     let obj_path = a.output.with_file_name(format!("{}_uv.obj", mesh_stem(&a.low)));
-    std::fs::write(&obj_path, obj_text(&low_uv)).with_context(|| format!("{}: cannot write", obj_path.display()))?;
+    raylab_render::film::atomic::write_atomic(&obj_path, obj_text(&low_uv)).with_context(|| format!("{}: cannot write", obj_path.display()))?;
     eprintln!(
         "Wrote {} and {}: {} texels covered, {:.2}% found the high mesh within {max_distance:.3e}; baked in {bake_seconds:.2} s.",
         a.output.display(),

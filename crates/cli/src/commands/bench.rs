@@ -73,6 +73,10 @@ pub fn cpu_name() -> String {
 
 pub fn run(a: &BenchArgs) -> Result<()> {
     let accels = parse_accels(&a.accels)?;
+    // The outputs are checked before the (long) benchmark, not after it.
+    for p in a.json.iter().chain(&a.report) {
+        raylab_render::film::atomic::check_writable(p).map_err(|e| anyhow::anyhow!("{e}"))?;
+    }
     let kinds: Vec<RayKind> = a.rays.split(',').map(|s| s.trim().parse::<RayKind>().map_err(|e| anyhow::anyhow!("--rays: {e}"))).collect::<Result<_>>()?;
     let mut b = rayon::ThreadPoolBuilder::new();
     if let Some(t) = a.threads {
@@ -92,11 +96,11 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     })?;
     let report = BenchReport { machine: Machine { cpu: cpu_name(), threads: pool.current_num_threads() }, raylab_version: env!("CARGO_PKG_VERSION").into(), repeats: a.repeats, resolution: a.resolution, results };
     if let Some(p) = &a.json {
-        std::fs::write(p, serde_json::to_string_pretty(&report)?).with_context(|| format!("{}: cannot write", p.display()))?;
+        raylab_render::film::atomic::write_atomic(p, serde_json::to_string_pretty(&report)?).with_context(|| format!("{}: cannot write", p.display()))?;
         eprintln!("Wrote {}.", p.display());
     }
     if let Some(p) = &a.report {
-        std::fs::write(p, raylab_lab::report::html(&report, &thumbnails)).with_context(|| format!("{}: cannot write", p.display()))?;
+        raylab_render::film::atomic::write_atomic(p, raylab_lab::report::html(&report, &thumbnails)).with_context(|| format!("{}: cannot write", p.display()))?;
         eprintln!("Wrote {}.", p.display());
     }
     Ok(())

@@ -138,7 +138,7 @@ fn render_with(scene: &mut Scene, strategy: LightSampling, spp: u32) -> raylab_r
 }
 
 fn write(path: &Path, text: String) -> Result<()> {
-    std::fs::write(path, text).map_err(|e| anyhow!("cannot write {}: {e}", path.display()))
+    raylab_render::film::atomic::write_atomic(path, text).map_err(|e| anyhow!("cannot write {}: {e}", path.display()))
 }
 
 /// The page's description of the study.

@@ -35,10 +35,10 @@ pub fn run(a: &GenArgs) -> Result<()> {
     let side_name = format!("{stem}.{}", if a.kind == "hair" { "curves" } else { "obj" });
     let size = raylab_procedural::Size { size: a.size, strands: a.strands, segments: a.segments };
     let g = raylab_procedural::generate(&a.kind, size, &side_name).map_err(anyhow::Error::msg)?;
-    std::fs::write(&a.output, &g.toml).with_context(|| format!("{}: cannot write", a.output.display()))?;
+    raylab_render::film::atomic::write_atomic(&a.output, &g.toml).with_context(|| format!("{}: cannot write", a.output.display()))?;
     if let Some(text) = &g.side_file {
         let side_path = a.output.with_file_name(&side_name);
-        std::fs::write(&side_path, text).with_context(|| format!("{}: cannot write", side_path.display()))?;
+        raylab_render::film::atomic::write_atomic(&side_path, text).with_context(|| format!("{}: cannot write", side_path.display()))?;
     }
     eprintln!("Wrote {} ({} spheres, {} triangles, {} curve segments).", a.output.display(), g.spheres, g.triangles, g.curve_segments);
     Ok(())

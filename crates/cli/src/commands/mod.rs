@@ -4,6 +4,7 @@ pub mod compare;
 pub mod converge;
 pub mod gen;
 pub mod inspect;
+pub mod merge;
 pub mod render;
 pub mod scene_args;
 pub mod trace;

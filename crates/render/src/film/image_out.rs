@@ -1,0 +1,251 @@
+//! Tone mapping and image writing, beside the film that produces the pixels: PNG (8-bit
+//! sRGB, via `image`), OpenEXR (linear float, via `exr`), PFM (linear float) and PPM (binary
+//! P6, the seeds' format). Every file is written atomically; every error starts with the path.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+use raylab_core::color::linear_to_srgb8;
+use raylab_core::Rgb;
+
+use super::atomic::write_atomic;
+
+/// Formats `write_image` can produce, for messages.
+pub fn image_format_names() -> &'static str {
+    "png, ppm, exr, pfm"
+}
+
+/// Exposures beyond ±64 stops scale any radiance a render can produce out of `f32`'s range
+/// (2^128 overflows), so they are refused rather than written as inf/NaN or black.
+pub const EXPOSURE_LIMIT: f32 = 64.0;
+
+/// Checks an exposure in stops; the message names the valid range.
+pub fn check_exposure(exposure: f32) -> Result<(), String> {
+    if !exposure.is_finite() || exposure.abs() > EXPOSURE_LIMIT {
+        return Err(format!("exposure {exposure} out of range (-{EXPOSURE_LIMIT} to {EXPOSURE_LIMIT} stops)"));
+    }
+    Ok(())
+}
+
+/// An image that could not be read or written.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {message}", path.display())]
+pub struct ImageError {
+    pub path: PathBuf,
+    pub message: String,
+}
+
+pub(crate) fn err(path: &Path, message: impl Into<String>) -> ImageError {
+    ImageError { path: path.to_path_buf(), message: message.into() }
+}
+
+/// How linear radiance becomes a displayable value in [0, 1] before sRGB encoding.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Tonemap {
+    /// Clip at 1 (the classic ray tracer's behaviour).
+    #[default]
+    Clamp,
+    /// `c / (1 + c)` per channel (Reinhard et al. 2002, simple form).
+    Reinhard,
+    /// Narkowicz's fit of the ACES filmic curve.
+    Aces,
+}
+
+impl Tonemap {
+    pub const ALL: [Tonemap; 3] = [Tonemap::Clamp, Tonemap::Reinhard, Tonemap::Aces];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Tonemap::Clamp => "clamp",
+            Tonemap::Reinhard => "reinhard",
+            Tonemap::Aces => "aces",
+        }
+    }
+
+    /// Maps one linear channel, scaled by `2^exposure`, into [0, 1]. Non-finite values give 0;
+    /// values that overflow when exposed saturate at 1.
+    pub fn apply(self, v: f32, exposure: f32) -> f32 {
+        if !v.is_finite() || v <= 0.0 {
+            return 0.0;
+        }
+        let v = (v * exposure.exp2()).min(f32::MAX);
+        match self {
+            Tonemap::Clamp => v.min(1.0),
+            Tonemap::Reinhard => v / (1.0 + v),
+            // The fit is 1 or more from v ≈ 7.24 on; past 1e4 its products would overflow.
+            Tonemap::Aces if v > 1e4 => 1.0,
+            Tonemap::Aces => ((v * (2.51 * v + 0.03)) / (v * (2.43 * v + 0.59) + 0.14)).clamp(0.0, 1.0),
+        }
+    }
+}
+
+/// An unknown tone-map name.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UnknownTonemap(pub String);
+
+impl fmt::Display for UnknownTonemap {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let names: Vec<_> = Tonemap::ALL.iter().map(|t| t.name()).collect();
+        write!(f, "unknown tone map `{}` (valid: {})", self.0, names.join(", "))
+    }
+}
+
+impl std::error::Error for UnknownTonemap {}
+
+impl FromStr for Tonemap {
+    type Err = UnknownTonemap;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Tonemap::ALL.into_iter().find(|t| t.name() == s).ok_or_else(|| UnknownTonemap(s.to_string()))
+    }
+}
+
+fn extension(path: &Path) -> String {
+    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
+}
+
+/// 8-bit sRGB bytes (RGB interleaved) after exposure and tone map.
+fn to_srgb8(pixels: &[Rgb], tonemap: Tonemap, exposure: f32) -> Vec<u8> {
+    pixels.iter().flat_map(|p| [p.x, p.y, p.z]).map(|v| linear_to_srgb8(tonemap.apply(v, exposure))).collect()
+}
+
+/// A linear value for the float formats: exposed, non-finite input as 0, overflow saturated.
+fn exposed(v: f32, scale: f32) -> f32 {
+    if v.is_finite() { (v * scale).clamp(-f32::MAX, f32::MAX) } else { 0.0 }
+}
+
+fn check_size(path: &Path, width: u32, height: u32, pixels: &[Rgb]) -> Result<(), ImageError> {
+    if pixels.len() != width as usize * height as usize {
+        return Err(err(path, format!("{} pixels for a {width}×{height} image", pixels.len())));
+    }
+    Ok(())
+}
+
+/// Encodes an image as PNG bytes (8-bit sRGB).
+pub fn encode_png(width: u32, height: u32, pixels: &[Rgb], tonemap: Tonemap, exposure: f32) -> Result<Vec<u8>, ImageError> {
+    let path = Path::new("<png>");
+    check_size(path, width, height, pixels)?;
+    check_exposure(exposure).map_err(|m| err(path, m))?;
+    let mut out = Vec::new();
+    let encoder = image::codecs::png::PngEncoder::new(&mut out);
+    image::ImageEncoder::write_image(encoder, &to_srgb8(pixels, tonemap, exposure), width, height, image::ExtendedColorType::Rgb8)
+        .map_err(|e| err(path, format!("cannot encode PNG: {e}")))?;
+    Ok(out)
+}
+
+/// Encodes an image in the format named by `path`'s extension. PNG and PPM get exposure,
+/// tone map and sRGB encoding; EXR and PFM keep linear radiance (exposure still scales it).
+pub fn encode_image(path: &Path, width: u32, height: u32, pixels: &[Rgb], tonemap: Tonemap, exposure: f32) -> Result<Vec<u8>, ImageError> {
+    check_size(path, width, height, pixels)?;
+    check_exposure(exposure).map_err(|m| err(path, m))?;
+    let scale = exposure.exp2();
+    Ok(match extension(path).as_str() {
+        "png" => encode_png(width, height, pixels, tonemap, exposure).map_err(|e| err(path, e.message))?,
+        "ppm" => {
+            let mut out = format!("P6\n{width} {height}\n255\n").into_bytes();
+            out.extend(to_srgb8(pixels, tonemap, exposure));
+            out
+        }
+        "pfm" => {
+            let mut out = format!("PF\n{width} {height}\n-1.0\n").into_bytes();
+            for row in pixels.chunks(width as usize).rev() {
+                for p in row {
+                    for v in [p.x, p.y, p.z] {
+                        out.extend(exposed(v, scale).to_le_bytes());
+                    }
+                }
+            }
+            out
+        }
+        "exr" => {
+            use exr::prelude::*;
+            let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+                let p = pixels[y * width as usize + x];
+                (exposed(p.x, scale), exposed(p.y, scale), exposed(p.z, scale))
+            });
+            let mut out = std::io::Cursor::new(Vec::new());
+            // Sequential: the parallel writer stores chunks in completion order, so the same
+            // pixels would give different bytes from run to run.
+            Image::from_channels((width as usize, height as usize), channels).write().non_parallel().to_buffered(&mut out).map_err(|e| err(path, format!("cannot encode OpenEXR: {e}")))?;
+            out.into_inner()
+        }
+        other => return Err(err(path, format!("unknown image format `.{other}` (valid: {})", image_format_names()))),
+    })
+}
+
+/// Writes an image atomically; the extension picks the format (see [`encode_image`]).
+pub fn write_image(path: &Path, width: u32, height: u32, pixels: &[Rgb], tonemap: Tonemap, exposure: f32) -> Result<(), ImageError> {
+    let bytes = encode_image(path, width, height, pixels, tonemap, exposure)?;
+    write_atomic(path, &bytes).map_err(|e| err(path, format!("cannot write: {e}")))
+}
+
+/// Writes 8-bit PNG values `round(255 · v)` with no tone map and no sRGB curve: for data
+/// such as normal maps, read back with `srgb = false`.
+pub fn write_linear_png(path: &Path, width: u32, height: u32, pixels: &[Rgb]) -> Result<(), ImageError> {
+    check_size(path, width, height, pixels)?;
+    let bytes: Vec<u8> = pixels.iter().flat_map(|p| [p.x, p.y, p.z]).map(|v| (exposed(v, 1.0).clamp(0.0, 1.0) * 255.0).round() as u8).collect();
+    let mut out = Vec::new();
+    image::ImageEncoder::write_image(image::codecs::png::PngEncoder::new(&mut out), &bytes, width, height, image::ExtendedColorType::Rgb8).map_err(|e| err(path, format!("cannot encode PNG: {e}")))?;
+    write_atomic(path, &out).map_err(|e| err(path, format!("cannot write PNG: {e}")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ppm_header_is_the_seeds_p6() {
+        let bytes = encode_image(Path::new("t.ppm"), 2, 1, &[Rgb::ONE, Rgb::ZERO], Tonemap::Clamp, 0.0).unwrap();
+        assert_eq!(bytes, b"P6\n2 1\n255\n\xff\xff\xff\x00\x00\x00");
+    }
+
+    #[test]
+    fn exr_bytes_are_the_same_every_time() {
+        // Many chunks of noise: a writer that emits chunks in completion order would differ.
+        let (w, h) = (97, 301);
+        let pixels: Vec<Rgb> = (0..w * h).map(|i| Rgb::new((i as f32 * 0.618).fract(), (i as f32 * 0.414).fract(), i as f32)).collect();
+        let first = encode_image(Path::new("t.exr"), w, h, &pixels, Tonemap::Clamp, 0.0).unwrap();
+        for _ in 0..8 {
+            assert!(encode_image(Path::new("t.exr"), w, h, &pixels, Tonemap::Clamp, 0.0).unwrap() == first);
+        }
+    }
+
+    #[test]
+    fn unknown_formats_and_exposures_are_refused() {
+        let e = write_image(Path::new("out.bmp"), 1, 1, &[Rgb::ONE], Tonemap::Clamp, 0.0).unwrap_err();
+        assert_eq!(e.to_string(), "out.bmp: unknown image format `.bmp` (valid: png, ppm, exr, pfm)");
+        let e = encode_image(Path::new("out.pfm"), 1, 1, &[Rgb::ONE], Tonemap::Clamp, 128.0).unwrap_err();
+        assert_eq!(e.to_string(), "out.pfm: exposure 128 out of range (-64 to 64 stops)");
+        let e = encode_image(Path::new("out.pfm"), 2, 1, &[Rgb::ONE], Tonemap::Clamp, 0.0).unwrap_err();
+        assert_eq!(e.to_string(), "out.pfm: 1 pixels for a 2×1 image");
+    }
+
+    #[test]
+    fn the_largest_exposure_stays_finite() {
+        // 2^64 · 1e30 overflows f32: saturated, never inf or NaN.
+        let bytes = encode_image(Path::new("t.pfm"), 1, 1, &[Rgb::new(1e30, 1.0, 0.0)], Tonemap::Clamp, 64.0).unwrap();
+        let body = &bytes[bytes.len() - 12..];
+        let v: Vec<f32> = body.chunks(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+        assert_eq!(v, vec![f32::MAX, 2f32.powi(64), 0.0]);
+        for t in Tonemap::ALL {
+            assert_eq!(t.apply(1e30, 64.0), 1.0, "{t:?}");
+        }
+    }
+
+    #[test]
+    fn tonemaps_are_monotone_and_bounded() {
+        for t in Tonemap::ALL {
+            assert_eq!(t.name().parse::<Tonemap>().unwrap(), t);
+            let mut last = 0.0;
+            for i in 0..1000 {
+                let v = t.apply(i as f32 * 0.05, 0.0);
+                assert!((0.0..=1.0).contains(&v) && v >= last, "{t:?}");
+                last = v;
+            }
+            assert_eq!(t.apply(f32::NAN, 0.0), 0.0);
+        }
+        assert_eq!(Tonemap::Clamp.apply(0.25, 1.0), 0.5);
+        assert_eq!(Tonemap::Reinhard.apply(1.0, 0.0), 0.5);
+        assert_eq!("gamma".parse::<Tonemap>().unwrap_err().to_string(), "unknown tone map `gamma` (valid: clamp, reinhard, aces)");
+    }
+}

@@ -1,0 +1,206 @@
+//! The film's promise: any split of a render (tiles, sample ranges, interruption and
+//! resume, a trip through the file format) gives the same bits as one uninterrupted render.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use raylab_accel::BuildOptions;
+use raylab_core::{Rgb, Transform, Vec3};
+
+use super::*;
+use crate::render::{film_header, render_tile, Control, Stop};
+use crate::{Camera, IntegratorKind, Light, Material, RenderSettings, SamplerKind, Scene, Sphere};
+
+/// Two diffuse spheres, one emitting, path traced with the random sampler: noisy, so any
+/// change in summation order would show in the low bits. 7 spp in passes of 2: four
+/// passes, the last of one sample.
+fn scene() -> Scene {
+    let camera = Camera::new(Vec3::new(0.0, 0.5, 4.0), Vec3::ZERO, Vec3::Y, 45.0, 4.0 / 3.0, 0.0, None).unwrap();
+    let settings = RenderSettings { width: 37, height: 21, spp: 7, sampler: SamplerKind::Random, integrator: IntegratorKind::Path, max_depth: 4, seed: 5, ..Default::default() };
+    let mut scene = Scene::new(camera, settings);
+    let m = scene.add_material("grey", Material::Diffuse { albedo: Rgb::splat(0.6).into() });
+    let sphere = |center, radius, emission| Sphere { center, radius, to_world: Transform::IDENTITY, material: m, emission };
+    scene.geometry.add_sphere(sphere(Vec3::ZERO, 1.0, Rgb::ZERO));
+    scene.geometry.add_sphere(sphere(Vec3::new(1.5, 1.5, 0.5), 0.4, Rgb::splat(8.0)));
+    scene.lights.push(Light::Point { position: Vec3::new(-2.0, 3.0, 2.0), intensity: Rgb::splat(20.0) });
+    scene.build_accel(&BuildOptions::default());
+    scene
+}
+
+const PASS: u32 = 2;
+
+fn never() -> AtomicBool {
+    AtomicBool::new(false)
+}
+
+fn render(scene: &Scene, crop: Crop, samples: std::ops::Range<u32>) -> Film {
+    let mut film = Film::new(film_header(scene, PASS), crop).unwrap();
+    let cancel = never();
+    let stop = render_tile(scene, &mut film, samples, &Control { cancel: &cancel, deadline: None, progress: &|_| {} }, |_| Ok::<(), FilmError>(())).unwrap();
+    assert_eq!(stop, Stop::Done);
+    film
+}
+
+fn bits(pixels: &[Rgb]) -> Vec<[u32; 3]> {
+    pixels.iter().map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]).collect()
+}
+
+#[test]
+fn tiles_sample_ranges_and_resumes_give_the_same_bits() {
+    let scene = scene();
+    let full = Crop::full(37, 21);
+    let whole = render(&scene, full, 0..7);
+    assert!(whole.is_complete());
+    assert_eq!(whole.blocks().iter().map(|b| (b.first, b.count)).collect::<Vec<_>>(), vec![(0, 4)]);
+    let reference = bits(&whole.resolve());
+    // Not a trivially flat image: the comparison below would mean nothing.
+    let mut distinct = reference.clone();
+    distinct.sort();
+    distinct.dedup();
+    assert!(distinct.len() > 150, "{}", distinct.len());
+
+    // Tiles: three bands, merged in reverse order.
+    let tiles: Vec<Film> = (0..3).rev().map(|i| render(&scene, Crop::tile(37, 21, i, 3).unwrap(), 0..7)).collect();
+    assert_eq!(bits(&Film::merge_all(tiles).unwrap().resolve()), reference, "tiles");
+
+    // Sample ranges on pass boundaries, merged out of order.
+    let ranges = vec![render(&scene, full, 6..7), render(&scene, full, 0..2), render(&scene, full, 2..6)];
+    let merged = Film::merge_all(ranges).unwrap();
+    assert_eq!(merged.blocks(), whole.blocks(), "the same blocks, bit for bit");
+    assert_eq!(bits(&merged.resolve()), reference, "sample ranges");
+    assert_eq!(merged.counters, whole.counters);
+
+    // Tiles × sample ranges: a crop of two columns of pixels, split in samples too.
+    let left = Crop { x0: 0, y0: 0, x1: 20, y1: 21 };
+    let right = Crop { x0: 20, y0: 0, x1: 37, y1: 21 };
+    let parts = vec![render(&scene, right, 0..7), render(&scene, left, 4..7), render(&scene, left, 0..4)];
+    assert_eq!(bits(&Film::merge_all(parts).unwrap().resolve()), reference, "crops × ranges");
+
+    // Interrupted after each pass in turn, saved, read back, resumed.
+    for stop_after in 1..4 {
+        let cancel = AtomicBool::new(false);
+        let control = Control { cancel: &cancel, deadline: None, progress: &|_| {} };
+        let mut film = Film::new(film_header(&scene, PASS), full).unwrap();
+        let mut passes = 0;
+        let stop = render_tile(&scene, &mut film, 0..7, &control, |_| {
+            passes += 1;
+            if passes == stop_after {
+                cancel.store(true, Ordering::Relaxed);
+            }
+            Ok::<(), FilmError>(())
+        })
+        .unwrap();
+        assert_eq!(stop, Stop::Cancelled);
+        assert_eq!(film.passes(), 0..stop_after);
+        let mut resumed = Film::from_bytes(&film.to_bytes()).unwrap();
+        assert_eq!(resumed, film);
+        let again = never();
+        let stop = render_tile(&scene, &mut resumed, 0..7, &Control { cancel: &again, deadline: None, progress: &|_| {} }, |_| Ok::<(), FilmError>(())).unwrap();
+        assert_eq!(stop, Stop::Done);
+        assert_eq!(bits(&resumed.resolve()), reference, "resumed after {stop_after} passes");
+    }
+}
+
+#[test]
+fn the_plain_render_is_the_mean_of_the_samples() {
+    // One pass per sample, f64 sums: the resolved pixel is the mean of the samples to f32
+    // precision, as the render loop computed before the film.
+    let scene = scene();
+    let out = crate::render(&scene, &|_| {});
+    assert_eq!(out.pixels.len(), 37 * 21);
+    let one_pass = render(&scene, Crop::full(37, 21), 0..7).resolve();
+    for (a, b) in out.pixels.iter().zip(&one_pass) {
+        assert!((*a - *b).abs().max_element() <= 1e-5 * a.max_element().max(1.0), "{a} vs {b}");
+    }
+}
+
+fn header() -> FilmHeader {
+    FilmHeader { width: 4, height: 2, spp: 5, pass_samples: 1, scene_hash: 1, settings_hash: 2, version: "test".into(), heatmap: false }
+}
+
+fn one_pixel_pass(v: f64) -> Vec<f64> {
+    vec![v, v, v, v * v]
+}
+
+#[test]
+fn blocks_are_the_binary_counter_of_the_passes() {
+    let crop = Crop { x0: 1, y0: 1, x1: 2, y1: 2 };
+    let mut film = Film::new(header(), crop).unwrap();
+    let shape = |f: &Film| f.blocks().iter().map(|b| (b.first, b.count)).collect::<Vec<_>>();
+    let mut seen = Vec::new();
+    for (p, v) in [1.0, 3.0, 0.5, 0.25, 2.0].into_iter().enumerate() {
+        film.add_pass(p as u32, one_pixel_pass(v), &Counters::default(), 0).unwrap();
+        seen.push(shape(&film));
+    }
+    assert_eq!(seen, vec![vec![(0, 1)], vec![(0, 2)], vec![(0, 2), (2, 1)], vec![(0, 4)], vec![(0, 4), (4, 1)]]);
+    // ((1 + 3) + (0.5 + 0.25)) + 2 = 6.75 over 5 samples.
+    assert_eq!(film.resolve(), vec![Rgb::splat(1.35)]);
+    // Luminance samples 1, 3, 0.5, 0.25, 2: mean 1.35, sample variance 1.2125, over n = 5.
+    let expected = (1.0f64 + 9.0 + 0.25 + 0.0625 + 4.0 - 6.75 * 6.75 / 5.0) / 4.0 / 5.0;
+    assert!((film.variance()[0] as f64 - expected).abs() < 1e-6, "{} vs {expected}", film.variance()[0]);
+    assert_eq!(film.add_pass(7, one_pixel_pass(1.0), &Counters::default(), 0).unwrap_err().to_string(), "pass 7 does not follow the passes 0..5 held (of 5)");
+}
+
+#[test]
+fn bad_merges_and_ranges_are_refused() {
+    let h = header();
+    let full = Crop::full(4, 2);
+    let pass = |crop: Crop, p: u32| {
+        let mut f = Film::new(h.clone(), crop).unwrap();
+        f.add_pass(p, vec![0.5; crop.pixels() * CHANNELS], &Counters::default(), 0).unwrap();
+        f
+    };
+    let e = Film::merge_all(vec![pass(full, 0), pass(full, 0)]).unwrap_err();
+    assert_eq!(e.to_string(), "cannot merge: crop 0,0,4,2: samples 0..1 and 0..1 overlap: samples would be counted twice");
+    let e = Film::merge_all(vec![pass(full, 0), pass(full, 2)]).unwrap_err();
+    assert_eq!(e.to_string(), "cannot merge: crop 0,0,4,2: samples 0..1 and 2..3 leave a gap");
+    let top = Crop { x0: 0, y0: 0, x1: 4, y1: 1 };
+    let e = Film::merge_all(vec![pass(top, 0), pass(Crop { x0: 1, y0: 0, x1: 4, y1: 2 }, 0)]).unwrap_err();
+    assert_eq!(e.to_string(), "cannot merge: crops 0,0,4,1 and 1,0,4,2 overlap: a pixel would be counted twice");
+    let e = Film::merge_all(vec![pass(top, 0), pass(Crop { x0: 1, y0: 1, x1: 4, y1: 2 }, 0)]).unwrap_err();
+    assert_eq!(e.to_string(), "cannot merge: the crops leave 1 pixels of 0,0,4,2 uncovered");
+    let mut other = pass(full, 1);
+    other.header.scene_hash = 9;
+    let e = Film::merge_all(vec![pass(full, 0), other]).unwrap_err();
+    assert_eq!(e.to_string(), "cannot merge: part 2 does not match part 1: it is of another scene (scene hash 0000000000000009, expected 0000000000000001)");
+    let h2 = FilmHeader { spp: 64, pass_samples: 16, ..h.clone() };
+    assert_eq!(h2.passes_of(&(16..64)).unwrap(), 1..4);
+    assert_eq!(h2.passes_of(&(8..64)).unwrap_err().to_string(), "samples 8..64 must be a non-empty range within 0..64 starting and ending on a multiple of the pass size 16");
+    assert_eq!(Crop::tile(4, 2, 2, 2).unwrap_err().to_string(), "tile 2/2: the index must be below the count (tiles are numbered from 0)");
+    assert_eq!(Crop::tile(4, 2, 0, 3).unwrap_err().to_string(), "tile 0/3: the image has only 2 rows, so at most 2 tiles");
+    let bands: Vec<Crop> = (0..3).map(|i| Crop::tile(10, 7, i, 3).unwrap()).collect();
+    assert_eq!(bands.iter().map(|c| (c.y0, c.y1)).collect::<Vec<_>>(), vec![(0, 2), (2, 4), (4, 7)]);
+}
+
+#[test]
+fn corrupt_film_files_are_refused_without_allocating() {
+    let mut film = Film::new(header(), Crop::full(4, 2)).unwrap();
+    film.add_pass(0, vec![0.25; 8 * CHANNELS], &Counters { rays: 8, ..Default::default() }, 1).unwrap();
+    let bytes = film.to_bytes();
+    assert_eq!(Film::from_bytes(&bytes).unwrap(), film);
+    let e = |b: &[u8]| Film::from_bytes(b).unwrap_err().to_string();
+    assert_eq!(e(b"PNG"), "not a raylab film: wrong magic bytes (expected RAYLABFM)");
+    assert_eq!(e(&bytes[..bytes.len() - 1]), "not a raylab film: checksum mismatch: the file is truncated or damaged");
+    let mut flipped = bytes.clone();
+    flipped[100] ^= 1;
+    assert_eq!(e(&flipped), "not a raylab film: checksum mismatch: the file is truncated or damaged");
+    // A header announcing a huge crop, with a valid checksum: refused by the size check.
+    let mut huge = bytes[..bytes.len() - 8].to_vec();
+    let crop_at = 8 + 4 * 5 + 1 + 16 + 2 + "test".len();
+    huge[crop_at + 8..crop_at + 16].copy_from_slice(&[0xff, 0xff, 0, 0, 0xff, 0xff, 0, 0]);
+    huge[12..20].copy_from_slice(&[0xff, 0xff, 0, 0, 0xff, 0xff, 0, 0]);
+    let mut sum = codec::Fnv64::default();
+    sum.update(&huge);
+    huge.extend_from_slice(&sum.0.to_le_bytes());
+    assert_eq!(e(&huge), format!("not a raylab film: the header announces 1 blocks of {} pixels ({} bytes) but {} bytes follow", 65535u64 * 65535, (65535u64 * 65535 * 32 + 8), 8 + 8 * 32));
+    let mut old = bytes.clone();
+    old[8] = 9;
+    assert_eq!(e(&old), "not a raylab film: film format version 9, this raylab reads version 1");
+}
+
+#[test]
+fn the_plain_render_of_no_samples_is_black_not_a_panic() {
+    let mut scene = scene();
+    scene.settings.spp = 0;
+    let out = crate::render(&scene, &|_| {});
+    assert_eq!(out.pixels, vec![Rgb::ZERO; 37 * 21]);
+}
