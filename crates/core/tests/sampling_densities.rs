@@ -1,0 +1,82 @@
+//! The warps' densities against their definitions: the fraction of cosine-hemisphere samples
+//! in a band of cos θ is ∫ cos θ / π dω = b² − a² (written out, not taken from
+//! `cosine_hemisphere_pdf`), and the pdf itself is cos θ / π and integrates to one.
+
+use raylab_core::sampling::{concentric_disk, cosine_hemisphere, cosine_hemisphere_pdf, uniform_sphere};
+use raylab_core::{Pcg32, Vec2};
+
+#[test]
+fn cosine_hemisphere_pdf_known_values() {
+    let pi = std::f32::consts::PI;
+    assert_eq!(cosine_hemisphere_pdf(1.0), 1.0 / pi);
+    assert!((cosine_hemisphere_pdf(0.5) - 0.5 / pi).abs() < 1e-7);
+    assert_eq!(cosine_hemisphere_pdf(0.0), 0.0);
+    assert_eq!(cosine_hemisphere_pdf(-0.3), 0.0, "nothing below the horizon");
+    // ∫ pdf dω = 2π ∫₀¹ pdf(z) dz (dω = dz dφ), midpoint rule.
+    let n = 10_000;
+    let integral: f64 = (0..n).map(|i| cosine_hemisphere_pdf((i as f32 + 0.5) / n as f32) as f64).sum::<f64>() * 2.0 * std::f64::consts::PI / n as f64;
+    assert!((integral - 1.0).abs() < 1e-5, "{integral}");
+}
+
+#[test]
+fn cosine_hemisphere_samples_follow_cos_over_pi() {
+    // 10 bands of cos θ × 8 sectors of φ; a band [a, b) holds (b² − a²)/8 of the samples per sector.
+    let (nz, np, n) = (10usize, 8usize, 200_000usize);
+    let mut observed = vec![0.0f64; nz * np];
+    let mut rng = Pcg32::new(17, 3);
+    for _ in 0..n {
+        let w = cosine_hemisphere(rng.next_vec2());
+        let iz = ((w.z * nz as f32) as usize).min(nz - 1);
+        let ip = ((w.y.atan2(w.x).rem_euclid(std::f32::consts::TAU) / std::f32::consts::TAU * np as f32) as usize).min(np - 1);
+        observed[iz * np + ip] += 1.0;
+    }
+    let expected: Vec<f64> = (0..nz * np)
+        .map(|c| {
+            let (a, b) = ((c / np) as f64 / nz as f64, (c / np + 1) as f64 / nz as f64);
+            (b * b - a * a) / np as f64 * n as f64
+        })
+        .collect();
+    let (chi2, dof) = chi_square(&expected, &observed);
+    assert!(chi2 < limit(dof), "χ² = {chi2} with {dof} dof");
+}
+
+#[test]
+fn concentric_disk_is_uniform_and_maps_the_square_edges_to_the_circle() {
+    // Equal-area rings: a fraction r² of the samples lies within radius r.
+    let mut rng = Pcg32::new(5, 8);
+    let n = 100_000;
+    let inside = (0..n).filter(|_| concentric_disk(rng.next_vec2()).length() < 0.5).count() as f64 / n as f64;
+    assert!((inside - 0.25).abs() < 0.007, "{inside}");
+    // The square's border goes to the unit circle, its centre to the origin.
+    for u in [Vec2::new(1.0, 0.5), Vec2::new(0.0, 0.3), Vec2::new(0.7, 1.0), Vec2::new(1.0, 1.0)] {
+        assert!((concentric_disk(u).length() - 1.0).abs() < 1e-6, "{u}");
+    }
+    assert_eq!(concentric_disk(Vec2::splat(0.5)), Vec2::ZERO);
+    assert!((concentric_disk(Vec2::new(1.0, 0.5)) - Vec2::X).length() < 1e-6);
+}
+
+#[test]
+fn uniform_sphere_has_uniform_height() {
+    // Archimedes: z is uniform on [−1, 1], so each of 10 bands holds a tenth.
+    let mut rng = Pcg32::new(9, 1);
+    let n = 100_000;
+    let mut bands = [0.0f64; 10];
+    for _ in 0..n {
+        let z = uniform_sphere(rng.next_vec2()).z;
+        bands[(((z + 1.0) * 5.0) as usize).min(9)] += 1.0;
+    }
+    let (chi2, dof) = chi_square(&[n as f64 / 10.0; 10], &bands);
+    assert!(chi2 < limit(dof), "χ² = {chi2}");
+}
+
+/// Pearson's χ² over cells that all expect at least 5 (true of the cells above), and its
+/// degrees of freedom (raylab-testkit has the pooled version; core cannot depend on it).
+fn chi_square(expected: &[f64], observed: &[f64]) -> (f64, usize) {
+    assert!(expected.iter().all(|&e| e >= 5.0));
+    (expected.iter().zip(observed).map(|(e, o)| (o - e) * (o - e) / e).sum(), expected.len() - 1)
+}
+
+/// Mean plus five standard deviations of χ² with `dof` degrees of freedom.
+fn limit(dof: usize) -> f64 {
+    dof as f64 + 5.0 * (2.0 * dof as f64).sqrt()
+}
