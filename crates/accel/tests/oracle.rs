@@ -99,7 +99,7 @@ fn cube_axis_rays_through_edges_and_vertices() {
 
 #[test]
 fn stanford_bunny() {
-    let path = kit::shared_scenes().join("bunny_4968.obj");
+    let path = kit::asset("bunny_4968.obj");
     let soup = kit::read_obj_triangles(&path);
     assert_eq!(soup.len(), 4968);
     let b = soup.bounds();
@@ -113,7 +113,7 @@ fn stanford_bunny() {
 /// statistics, and a BVH tests far fewer primitives per ray than brute force.
 #[test]
 fn counters_and_stats_on_bunny() {
-    let soup = kit::read_obj_triangles(&kit::shared_scenes().join("bunny_4968.obj"));
+    let soup = kit::read_obj_triangles(&kit::asset("bunny_4968.obj"));
     let b = soup.bounds();
     let mut rng = Pcg32::new(11, 1);
     let rays = kit::random_rays(&mut rng, 500, &Aabb::new(b.min - b.extent(), b.max + b.extent()), &b);

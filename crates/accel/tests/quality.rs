@@ -8,8 +8,6 @@
 //! tighten the record. Re-record with `RAYLAB_RECORD_QUALITY=1 cargo test -p raylab-accel
 //! --test quality -- --nocapture` and paste the printed rows.
 
-use std::path::PathBuf;
-
 use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters};
 use raylab_core::{Aabb, Pcg32, Vec3};
 use raylab_testkit::{self as kit, Soup};
@@ -48,7 +46,7 @@ const RECORDED: &[(&str, &str, f64, f64, f64)] = &[
 /// The scenes, all in the repository (never `../shared`): the 4968-triangle bunny, and a
 /// seeded soup of uneven random triangles.
 fn scenes() -> Vec<(&'static str, Soup)> {
-    let bunny = kit::read_obj_triangles(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/bunny_4968.obj"));
+    let bunny = kit::read_obj_triangles(&kit::asset("bunny_4968.obj"));
     assert_eq!(bunny.prims.len(), 4968);
     let mut rng = Pcg32::new(2024, 7);
     let mut soup = kit::random_triangles(&mut rng, 1500, &Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0)), 0.05);

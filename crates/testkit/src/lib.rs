@@ -120,9 +120,36 @@ pub fn cube() -> Soup {
     Soup::triangles(faces.iter().flat_map(|f| [[c[f[0]], c[f[1]], c[f[2]]], [c[f[0]], c[f[2]], c[f[3]]]]))
 }
 
-/// The folder of shared scenes (`../shared/scenes` beside the repository).
+/// The folder of shared scenes: `$RAYLAB_SHARED` when set (pointing it at a missing folder
+/// shows which tests need the shared data), else `../shared/scenes` beside the repository.
 pub fn shared_scenes() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes")
+    match std::env::var_os("RAYLAB_SHARED") {
+        Some(dir) => PathBuf::from(dir),
+        None => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes"),
+    }
+}
+
+/// `name` in [`shared_scenes`], or `None` after saying on stderr which file is missing and
+/// where it was looked for: the caller returns early, so a checkout without the shared data
+/// skips the test instead of failing it (`let Some(path) = shared_file("x") else { return };`).
+pub fn shared_file(name: &str) -> Option<PathBuf> {
+    let path = shared_scenes().join(name);
+    if path.is_file() {
+        return Some(path);
+    }
+    eprintln!("skipped: needs the shared scene file `{name}`, not found at {} (set RAYLAB_SHARED to the shared `scenes` folder)", path.display());
+    None
+}
+
+/// Whether every file in `names` is in [`shared_scenes`] (each missing one is reported as by
+/// [`shared_file`]).
+pub fn shared_files(names: &[&str]) -> bool {
+    names.iter().map(|n| shared_file(n).is_some()).fold(true, |a, b| a && b)
+}
+
+/// A file of the repository's `assets/` folder (always present, unlike the shared data).
+pub fn asset(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets").join(name)
 }
 
 /// Reads the vertices and triangular faces of a plain OBJ file (tests only; the real
