@@ -53,6 +53,27 @@ fn concentric_disk_is_uniform_and_maps_the_square_edges_to_the_circle() {
     }
     assert_eq!(concentric_disk(Vec2::splat(0.5)), Vec2::ZERO);
     assert!((concentric_disk(Vec2::new(1.0, 0.5)) - Vec2::X).length() < 1e-6);
+    // Shirley & Chiu: the square's point o = 2u − 1 maps to radius max(|oₓ|, |o_y|) and angle
+    // π/4 · o_y/oₓ in the wedges around ±x, π/2 − π/4 · oₓ/o_y in those around ±y.
+    let polar = |r: f32, a: f32| Vec2::new(r * a.cos(), r * a.sin());
+    let pi = std::f32::consts::PI;
+    for (u, expected) in [
+        (Vec2::new(1.0, 0.75), polar(1.0, pi / 8.0)),
+        (Vec2::new(0.75, 1.0), polar(1.0, 3.0 * pi / 8.0)),
+        (Vec2::new(0.7, 0.6), polar(0.4, pi / 4.0 * 0.5)),
+        (Vec2::new(0.6, 0.2), polar(-0.6, pi / 2.0 - pi / 4.0 * (0.2 / -0.6))),
+        (Vec2::new(0.25, 0.25), polar(-0.5, pi / 4.0)),
+    ] {
+        assert!((concentric_disk(u) - expected).length() < 1e-6, "{u}: {} vs {expected}", concentric_disk(u));
+    }
+    // Uniform in angle too: 16 equal sectors hold a sixteenth each.
+    let mut sectors = [0.0f64; 16];
+    for _ in 0..n {
+        let d = concentric_disk(rng.next_vec2());
+        sectors[((d.y.atan2(d.x).rem_euclid(std::f32::consts::TAU) / std::f32::consts::TAU * 16.0) as usize).min(15)] += 1.0;
+    }
+    let (chi2, dof) = chi_square(&[n as f64 / 16.0; 16], &sectors);
+    assert!(chi2 < limit(dof), "sectors: χ² = {chi2}");
 }
 
 #[test]

@@ -1,0 +1,60 @@
+//! Hand-computed values for the small helpers of `raylab-core` (written for survivors of
+//! mutation testing, docs/testing.md): every expected value is worked out in the test.
+
+use raylab_core::color::luminance;
+use raylab_core::offset::{gamma, offset_ray_origin};
+use raylab_core::{Ray, Rgb, Vec3};
+
+#[test]
+fn rec709_luminance() {
+    // Rec. 709 / sRGB primaries: Y = 0.2126 R + 0.7152 G + 0.0722 B; white has Y = 1.
+    assert_eq!(luminance(Rgb::new(1.0, 0.0, 0.0)), 0.2126);
+    assert_eq!(luminance(Rgb::new(0.0, 1.0, 0.0)), 0.7152);
+    assert_eq!(luminance(Rgb::new(0.0, 0.0, 1.0)), 0.0722);
+    assert!((luminance(Rgb::ONE) - 1.0).abs() < 1e-6);
+    assert!((luminance(Rgb::new(2.0, 0.5, 4.0)) - (0.4252 + 0.3576 + 0.2888)).abs() < 1e-6);
+}
+
+#[test]
+fn gamma_is_higham_bound() {
+    // γₙ = nu / (1 − nu), u = 2⁻²⁴ (half an ulp of 1 in f32).
+    for n in [1u32, 3, 5, 7] {
+        let u = (2.0f64).powi(-24);
+        let expected = n as f64 * u / (1.0 - n as f64 * u);
+        assert!((gamma(n) as f64 - expected).abs() < 1e-6 * expected, "γ{n} = {}, expected {expected}", gamma(n));
+    }
+}
+
+#[test]
+fn offset_moves_by_the_projected_error_then_one_ulp() {
+    // No error: only the one-ulp push, along the normal's non-zero components only.
+    let p = Vec3::new(1.0, 2.0, 3.0);
+    let o = offset_ray_origin(p, Vec3::ZERO, Vec3::Z, Vec3::new(1.0, 0.0, 0.0));
+    assert_eq!(o, Vec3::new(1.0, 2.0, 3.0f32.next_up()), "a tangent direction keeps the normal's side");
+    let o = offset_ray_origin(p, Vec3::ZERO, Vec3::Z, Vec3::new(0.0, 0.3, -1.0));
+    assert_eq!(o, Vec3::new(1.0, 2.0, 3.0f32.next_down()), "a direction below flips the normal");
+    // With an error box (0.1, 0.2, 0.3) and n = (0, 0.6, 0.8): d = 0.2·0.6 + 0.3·0.8 = 0.36.
+    let n = Vec3::new(0.0, 0.6, 0.8);
+    let o = offset_ray_origin(p, Vec3::new(0.1, 0.2, 0.3), n, n);
+    let moved = p + 0.36 * n;
+    assert_eq!(o.x, 1.0);
+    assert!((o.y - moved.y.next_up()).abs() <= 2.0 * f32::EPSILON * 3.0 && o.y > moved.y - 1e-6, "{o} vs {moved}");
+    assert!((o.z - moved.z.next_up()).abs() <= 2.0 * f32::EPSILON * 4.0, "{o} vs {moved}");
+    // Negative normal components move down.
+    let o = offset_ray_origin(p, Vec3::ZERO, -Vec3::X, -Vec3::X);
+    assert_eq!(o, Vec3::new(1.0f32.next_down(), 2.0, 3.0));
+}
+
+#[test]
+fn ray_points_and_validity() {
+    let r = Ray::new(Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.5, -1.0, 2.0));
+    assert_eq!(r.at(2.0), Vec3::new(2.0, 0.0, 7.0));
+    assert_eq!(r.at(0.0), r.origin);
+    assert!(r.is_valid());
+    assert!(!Ray::new(Vec3::new(f32::NAN, 0.0, 0.0), Vec3::X).is_valid(), "NaN origin");
+    assert!(!Ray::new(Vec3::ZERO, Vec3::new(0.0, f32::INFINITY, 0.0)).is_valid(), "infinite direction");
+    assert!(!Ray::new(Vec3::ZERO, Vec3::ZERO).is_valid(), "zero direction");
+    assert!(!Ray::segment(Vec3::ZERO, Vec3::X, f32::NAN, 1.0).is_valid(), "NaN t_min");
+    assert!(!Ray::segment(Vec3::ZERO, Vec3::X, 0.0, f32::NAN).is_valid(), "NaN t_max");
+    assert!(Ray::segment(Vec3::ZERO, Vec3::X, 0.5, f32::INFINITY).is_valid());
+}
