@@ -2,7 +2,7 @@
 //! in a band of cos θ is ∫ cos θ / π dω = b² − a² (written out, not taken from
 //! `cosine_hemisphere_pdf`), and the pdf itself is cos θ / π and integrates to one.
 
-use raylab_core::sampling::{concentric_disk, cosine_hemisphere, cosine_hemisphere_pdf, uniform_sphere};
+use raylab_core::sampling::{concentric_disk, cosine_hemisphere, cosine_hemisphere_pdf, uniform_sphere, uniform_triangle};
 use raylab_core::{Pcg32, Vec2};
 
 #[test]
@@ -88,6 +88,31 @@ fn uniform_sphere_has_uniform_height() {
     }
     let (chi2, dof) = chi_square(&[n as f64 / 10.0; 10], &bands);
     assert!(chi2 < limit(dof), "χ² = {chi2}");
+    // z = 1 − 2u₁, φ = 2πu₂: u = (1/4, 1/4) is z = 1/2, φ = π/2.
+    let w = uniform_sphere(Vec2::splat(0.25));
+    assert!((w - raylab_core::Vec3::new(0.0, 0.75f32.sqrt(), 0.5)).length() < 1e-6, "{w}");
+    let w = uniform_sphere(Vec2::new(0.5, 0.625));
+    assert!((w - raylab_core::Vec3::new(-(0.5f32.sqrt()), -(0.5f32.sqrt()), 0.0)).length() < 1e-6, "{w}");
+}
+
+#[test]
+fn uniform_triangle_hand_values_and_uniformity() {
+    // Heitz 2019: u₁ < u₂ gives b₀ = u₁/2, b₁ = u₂ − b₀; otherwise b₁ = u₂/2, b₀ = u₁ − b₁.
+    assert_eq!(uniform_triangle(Vec2::new(0.2, 0.6)), (0.1, 0.5));
+    assert_eq!(uniform_triangle(Vec2::new(0.6, 0.2)), (0.5, 0.1));
+    assert_eq!(uniform_triangle(Vec2::new(0.0, 1.0)), (0.0, 1.0));
+    // Uniform over the triangle: the four midpoint sub-triangles hold a quarter each.
+    let mut rng = Pcg32::new(23, 4);
+    let n = 80_000;
+    let mut parts = [0.0f64; 4];
+    for _ in 0..n {
+        let (b0, b1) = uniform_triangle(rng.next_vec2());
+        let b2 = 1.0 - b0 - b1;
+        let k = if b0 > 0.5 { 0 } else if b1 > 0.5 { 1 } else if b2 > 0.5 { 2 } else { 3 };
+        parts[k] += 1.0;
+    }
+    let (chi2, dof) = chi_square(&[n as f64 / 4.0; 4], &parts);
+    assert!(chi2 < limit(dof), "{parts:?}");
 }
 
 /// Pearson's χ² over cells that all expect at least 5 (true of the cells above), and its
