@@ -61,3 +61,29 @@ fn ray_points_and_validity() {
     assert!(!Ray::segment(Vec3::ZERO, Vec3::X, 0.0, f32::NAN).is_valid(), "NaN t_max");
     assert!(Ray::segment(Vec3::ZERO, Vec3::X, 0.5, f32::INFINITY).is_valid());
 }
+
+#[test]
+fn distributions_at_the_edges_of_the_unit_interval() {
+    use raylab_core::{Distribution1D, Distribution2D, Vec2};
+    // Weights (1, 3): densities 0.5 and 1.5 (mean 2); x = 1 belongs to the last step.
+    let d = Distribution1D::new(&[1.0, 3.0]);
+    assert!(!d.is_empty() && d.len() == 2);
+    assert_eq!((d.pdf(0.0), d.pdf(0.49), d.pdf(0.5), d.pdf(1.0)), (0.5, 0.5, 1.5, 1.5));
+    // CDF (0, 1/4, 1): u = 0.25 + 0.75·0.5 is the middle of the second step.
+    let (x, pdf, step) = d.sample(0.625);
+    assert_eq!((step, pdf), (1, 1.5));
+    assert!((x - 0.75).abs() < 1e-6, "{x}");
+    // u = 1 (outside [0, 1), from rounding elsewhere) still lands inside [0, 1).
+    let (x, pdf, step) = d.sample(1.0);
+    assert_eq!((step, pdf), (1, 1.5));
+    assert!(x < 1.0 && x > 0.999, "{x}");
+    // A zero-width last step reached only by clamping: its middle, not NaN.
+    let (x, pdf, step) = Distribution1D::new(&[1.0, 0.0]).sample(1.0);
+    assert_eq!((x, pdf, step), (0.75, 0.0, 1));
+    // 2 × 2 weights (1, 3 / 0, 4): rows' integrals 2 and 2, marginal densities 1 and 1.
+    let d2 = Distribution2D::new(&[1.0, 3.0, 0.0, 4.0], 2, 2);
+    assert_eq!(d2.integral(), 2.0);
+    assert_eq!(d2.pdf(Vec2::new(0.2, 0.2)), 0.5);
+    assert_eq!(d2.pdf(Vec2::new(1.0, 1.0)), 2.0);
+    assert_eq!(d2.pdf(Vec2::new(0.2, 1.0)), 0.0);
+}
