@@ -144,4 +144,17 @@ fn transforms_by_hand() {
     let b = t.bounds(&Aabb::new(Vec3::new(0.0, -1.0, 2.0), Vec3::new(0.5, 1.0, 4.0)));
     assert_eq!((b.min, b.max), (Vec3::new(1.0, 1.0, 5.0), Vec3::new(1.5, 3.0, 7.0)));
     assert!(t.bounds(&Aabb::EMPTY).is_empty());
+    // About x, every corner counts: the box of the eight transformed corners, listed here.
+    let rx = Transform::rotate(Vec3::new(1.0, 0.2, 0.0), 50.0).unwrap();
+    let (lo, hi) = (Vec3::new(0.0, -1.0, 2.0), Vec3::new(0.5, 1.0, 4.0));
+    let corners = [(lo.x, lo.y, lo.z), (hi.x, lo.y, lo.z), (lo.x, hi.y, lo.z), (hi.x, hi.y, lo.z), (lo.x, lo.y, hi.z), (hi.x, lo.y, hi.z), (lo.x, hi.y, hi.z), (hi.x, hi.y, hi.z)];
+    let (mut min, mut max) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for (x, y, z) in corners {
+        let p = rx.point(Vec3::new(x, y, z));
+        (min, max) = (min.min(p), max.max(p));
+    }
+    let b = rx.bounds(&Aabb::new(lo, hi));
+    assert_eq!((b.min, b.max), (min, max));
+    // Singular means |det| below 1e-30: a scale of exactly 1e-30 is still invertible.
+    assert!(Transform::scale(Vec3::new(1e-30, 1.0, 1.0)).is_some());
 }
