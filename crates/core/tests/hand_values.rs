@@ -158,3 +158,26 @@ fn transforms_by_hand() {
     // Singular means |det| below 1e-30: a scale of exactly 1e-30 is still invertible.
     assert!(Transform::scale(Vec3::new(1e-30, 1.0, 1.0)).is_some());
 }
+
+#[test]
+fn aabb_measures_by_hand() {
+    use raylab_core::Aabb;
+    // A 1 × 2 × 4 box from (1, −1, 2): areas 2, 8, 4 per face pair.
+    let b = Aabb::new(Vec3::new(1.0, -1.0, 2.0), Vec3::new(2.0, 1.0, 6.0));
+    assert_eq!((b.half_area(), b.surface_area(), b.volume()), (14.0, 28.0, 8.0));
+    assert_eq!((b.extent(), b.centroid()), (Vec3::new(1.0, 2.0, 4.0), Vec3::new(1.5, 0.0, 4.0)));
+    assert_eq!(b.max_axis(), 2);
+    assert_eq!(Aabb::new(Vec3::ZERO, Vec3::new(3.0, 2.0, 1.0)).max_axis(), 0);
+    assert_eq!(Aabb::new(Vec3::ZERO, Vec3::new(1.0, 3.0, 2.0)).max_axis(), 1);
+    assert_eq!((Aabb::EMPTY.half_area(), Aabb::EMPTY.surface_area()), (0.0, 0.0));
+    // Closed box: faces belong to it.
+    assert!(b.contains(Vec3::new(1.0, 1.0, 6.0)) && b.contains(Vec3::new(1.5, 0.0, 3.0)));
+    assert!(!b.contains(Vec3::new(0.99, 0.0, 3.0)) && !b.contains(Vec3::new(1.5, 0.0, 6.01)));
+    assert!(b.contains_box(&Aabb::new(Vec3::new(1.0, 0.0, 3.0), Vec3::new(2.0, 1.0, 4.0))));
+    assert!(!b.contains_box(&Aabb::new(Vec3::new(1.0, 0.0, 3.0), Vec3::new(2.5, 1.0, 4.0))));
+    assert!(b.contains_box(&Aabb::EMPTY));
+    // Relative position: 0 at min, 1 at max; a flat axis gives 0.
+    assert_eq!(b.offset(Vec3::new(1.5, 1.0, 3.0)), Vec3::new(0.5, 1.0, 0.25));
+    let flat = Aabb::new(Vec3::ZERO, Vec3::new(2.0, 0.0, 4.0));
+    assert_eq!(flat.offset(Vec3::new(1.0, 0.0, 1.0)), Vec3::new(0.5, 0.0, 0.25));
+}
