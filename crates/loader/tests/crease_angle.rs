@@ -19,12 +19,18 @@ fn mesh(keys: &str) -> TriangleMesh {
 
 #[test]
 fn crease_angle_is_checked() {
+    if !raylab_testkit::shared_files(&["teapot_6320.obj"]) {
+        return;
+    }
     assert_eq!(teapot("smooth = true\ncrease_angle = 200\n").err().unwrap(), "s.toml:9: shapes[0].crease_angle: must be between 0 and 180, found 200");
     assert_eq!(teapot("crease_angle = 30\n").err().unwrap(), "s.toml:8: shapes[0].crease_angle: needs `smooth = true`");
 }
 
 #[test]
 fn crease_angle_180_is_plain_smoothing_and_smaller_angles_split_sharp_edges() {
+    if !raylab_testkit::shared_files(&["teapot_6320.obj"]) {
+        return;
+    }
     let plain = mesh("smooth = true\n");
     let all = mesh("smooth = true\ncrease_angle = 180\n");
     assert_eq!((&plain.positions, &plain.normals, &plain.indices), (&all.positions, &all.normals, &all.indices));

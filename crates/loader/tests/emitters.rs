@@ -8,6 +8,9 @@ use raylab_render::IntegratorKind;
 
 #[test]
 fn cornell_box_light_pixels_read_exactly_its_radiance() {
+    if !raylab_testkit::shared_files(&["CornellBox-Original.obj", "CornellBox-Original.mtl"]) {
+        return;
+    }
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell_path.toml");
     // Looking up at the ceiling: only what the camera sees directly (max_depth 1).
     let overrides = Overrides { width: Some(48), height: Some(48), spp: Some(4), max_depth: Some(1), integrator: Some(IntegratorKind::Path), ..Default::default() };

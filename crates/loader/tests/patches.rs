@@ -22,6 +22,9 @@ fn newell_teapot(subdivisions: u32) -> TriangleMesh {
 
 #[test]
 fn default_tessellation_is_the_common_6320_triangle_teapot() {
+    if !raylab_testkit::shared_files(&["teapot_newell_patches.txt"]) {
+        return;
+    }
     let patches = teapot("teapot_newell_patches.txt");
     assert_eq!(patches.len(), 32);
     let mesh = tessellate(&patches, DEFAULT_SUBDIVISIONS);
@@ -42,6 +45,9 @@ fn default_tessellation_is_the_common_6320_triangle_teapot() {
 
 #[test]
 fn txt_and_bpt_give_the_same_tessellation() {
+    if !raylab_testkit::shared_files(&["teapot_newell_patches.txt", "teapot.bpt"]) {
+        return;
+    }
     let (txt, bpt) = (teapot("teapot_newell_patches.txt"), teapot("teapot.bpt"));
     assert_eq!(txt, bpt);
     let (a, b) = (tessellate(&txt, 7), tessellate(&bpt, 7));
@@ -50,6 +56,9 @@ fn txt_and_bpt_give_the_same_tessellation() {
 
 #[test]
 fn vertex_normals_agree_with_the_triangles() {
+    if !raylab_testkit::shared_files(&["teapot_newell_patches.txt"]) {
+        return;
+    }
     let mesh = newell_teapot(DEFAULT_SUBDIVISIONS);
     let mut disagree = 0;
     for tri in 0..mesh.len() as u32 {
@@ -74,6 +83,9 @@ fn faces_out(g: &Geometry, accel: &AnyAccel, mesh: &TriangleMesh, tri: u32) -> b
 
 #[test]
 fn newell_data_is_oriented_outwards() {
+    if !raylab_testkit::shared_files(&["teapot_newell_patches.txt"]) {
+        return;
+    }
     // The teapot is not closed (the spout and handle pierce the body, the lid sits in the
     // rim), so parity misjudges some triangles near those seams; per patch, the large
     // majority still says whether ∂P/∂u × ∂P/∂v points out.
@@ -96,6 +108,9 @@ fn newell_data_is_oriented_outwards() {
 
 #[test]
 fn every_accel_agrees_with_brute_force_on_the_teapot() {
+    if !raylab_testkit::shared_files(&["teapot_newell_patches.txt"]) {
+        return;
+    }
     let mut g = Geometry::default();
     g.add_mesh(newell_teapot(DEFAULT_SUBDIVISIONS));
     let b = g.total_bounds();
@@ -137,6 +152,9 @@ fn scene_error(shape: &str) -> String {
 
 #[test]
 fn example_scene_stands_the_teapot_up() {
+    if !raylab_testkit::shared_files(&["teapot_newell_patches.txt"]) {
+        return;
+    }
     let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/teapot_patches.toml");
     let scene = load_scene(&path, &Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
     let teapot = &scene.geometry.meshes[0];
@@ -152,6 +170,9 @@ fn example_scene_stands_the_teapot_up() {
 
 #[test]
 fn bezier_patch_shape_errors() {
+    if !raylab_testkit::shared_files(&["teapot.bpt"]) {
+        return;
+    }
     assert_eq!(scene_error("file = \"teapot.bpt\"\nsubdivisions = 0\n"), "bad.toml:8: shapes[0].subdivisions: must be between 1 and 256, found 0");
     assert_eq!(scene_error("file = \"teapot.bpt\"\nsmooth = true\n"), "bad.toml:8: shapes[0].smooth: not a field of `bezier_patch` shapes (valid: type, material, transform, file, mode, subdivisions)");
     assert_eq!(scene_error("file = \"teapot.bpt\"\nmode = \"exact\"\n"), "bad.toml:8: shapes[0].mode: unknown mode `exact` (valid: tessellate, direct)");
@@ -165,6 +186,9 @@ fn bezier_patch_shape_errors() {
 /// about 1e-4 of the surface) on the same rays.
 #[test]
 fn newton_patches_agree_with_a_fine_tessellation() {
+    if !raylab_testkit::shared_files(&["teapot_newell_patches.txt"]) {
+        return;
+    }
     let patches = teapot("teapot_newell_patches.txt");
     // A 4 × 4 seed grid misses the nearer of two roots on a few grazing rays here
     // (distances off by up to 0.66); 8 × 8 finds them all.
@@ -199,6 +223,9 @@ fn newton_patches_agree_with_a_fine_tessellation() {
 
 #[test]
 fn every_accel_agrees_with_brute_force_on_newton_patches() {
+    if !raylab_testkit::shared_files(&["teapot.bpt"]) {
+        return;
+    }
     let surfaces = PatchSurfaces::new(teapot("teapot.bpt"), 8, Default::default());
     let b = raylab_accel::primitives::total_bounds(&surfaces);
     let rays = kit::random_rays(&mut Pcg32::new(8, 64), 1000, &Aabb::new(b.min - b.extent(), b.max + b.extent()), &b);
@@ -220,6 +247,9 @@ fn every_accel_agrees_with_brute_force_on_newton_patches() {
 /// 40 is silhouette pixels at one sample each).
 #[test]
 fn direct_patches_render_like_fine_tessellations() {
+    if !raylab_testkit::shared_files(&["teapot_newell_patches.txt"]) {
+        return;
+    }
     let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
     let o = Overrides { width: Some(80), height: Some(60), spp: Some(1), ..Default::default() };
     let render = |scene: raylab_render::Scene| raylab_render::render(&scene, &|_| {}).pixels;

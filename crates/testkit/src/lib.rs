@@ -127,9 +127,36 @@ pub fn cube() -> Soup {
     Soup::triangles(faces.iter().flat_map(|f| [[c[f[0]], c[f[1]], c[f[2]]], [c[f[0]], c[f[2]], c[f[3]]]]))
 }
 
-/// The folder of shared scenes (`../shared/scenes` beside the repository).
+/// The folder of shared scenes: `$RAYLAB_SHARED` when set (pointing it at a missing folder
+/// shows which tests need the shared data), else `../shared/scenes` beside the repository.
 pub fn shared_scenes() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes")
+    match std::env::var_os("RAYLAB_SHARED") {
+        Some(dir) => PathBuf::from(dir),
+        None => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes"),
+    }
+}
+
+/// `name` in [`shared_scenes`], or `None` after saying on stderr which file is missing and
+/// where it was looked for: the caller returns early, so a checkout without the shared data
+/// skips the test instead of failing it (`let Some(path) = shared_file("x") else { return };`).
+pub fn shared_file(name: &str) -> Option<PathBuf> {
+    let path = shared_scenes().join(name);
+    if path.is_file() {
+        return Some(path);
+    }
+    eprintln!("skipped: needs the shared scene file `{name}`, not found at {} (set RAYLAB_SHARED to the shared `scenes` folder)", path.display());
+    None
+}
+
+/// Whether every file in `names` is in [`shared_scenes`] (each missing one is reported as by
+/// [`shared_file`]).
+pub fn shared_files(names: &[&str]) -> bool {
+    names.iter().map(|n| shared_file(n).is_some()).fold(true, |a, b| a && b)
+}
+
+/// A file of the repository's `assets/` folder (always present, unlike the shared data).
+pub fn asset(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets").join(name)
 }
 
 /// Reads the vertices and triangular faces of a plain OBJ file (tests only; the real
@@ -182,4 +209,44 @@ pub fn chi_square(expected: &[f64], observed: &[f64]) -> (f64, usize) {
 /// (p ≈ 1e-5 of a false alarm).
 pub fn chi_square_limit(dof: usize) -> f64 {
     dof as f64 + 5.0 * (2.0 * dof as f64).sqrt()
+}
+
+/// How far (in units in the last place of the oracle's distance) a structure's closest hit
+/// may lie behind the oracle's. Box and plane tests round too: where coplanar triangles
+/// overlap (fans, duplicated faces) their distances along one ray differ by an ulp or two,
+/// and a box entry rounded up by an ulp may prune the nearer one after the farther one was
+/// found. pbrt-v4 bounds that rounding by 2γ₃ ≈ 3.6e-7 relative (3 ulps); 4 ulps cover it.
+pub const ORACLE_ULPS: u32 = 4;
+
+/// What "agrees with the oracle" means for a closest-hit query (documented in
+/// docs/testing.md): both miss, or both hit and
+/// 1. the reported hit is genuine: its primitive, intersected alone, gives exactly its `t`;
+/// 2. it is not nearer than the true closest hit (nothing is invented in front of it);
+/// 3. it is at most [`ORACLE_ULPS`] ulps behind the oracle's `t`: only a tie, or a near tie
+///    between overlapping coplanar primitives, may resolve differently.
+///
+/// A different primitive at the same (or near-tied) distance is therefore accepted; any
+/// real bug (a missed nearer surface, a wrong `t`, a hit that does not exist) is not.
+pub fn agrees_with_oracle<P: Primitives + ?Sized>(prims: &P, ray: &Ray, want: Option<raylab_accel::Hit>, got: Option<raylab_accel::Hit>) -> Result<(), String> {
+    match (want, got) {
+        (None, None) => Ok(()),
+        (Some(w), Some(g)) => {
+            if g.t == w.t && g.prim == w.prim {
+                return Ok(());
+            }
+            let again = prims.intersect(g.prim, ray).map(|h| h.t);
+            if again != Some(g.t) {
+                return Err(format!("prim {} reported at t = {} but intersects at {again:?}", g.prim, g.t));
+            }
+            if g.t < w.t {
+                return Err(format!("t = {} (prim {}) is nearer than the oracle's closest {} (prim {})", g.t, g.prim, w.t, w.prim));
+            }
+            let ulps = g.t.to_bits() - w.t.to_bits();
+            if ulps > ORACLE_ULPS {
+                return Err(format!("t = {} (prim {}) is {ulps} ulps behind the oracle's {} (prim {})", g.t, g.prim, w.t, w.prim));
+            }
+            Ok(())
+        }
+        (w, g) => Err(format!("{g:?} vs oracle {w:?}")),
+    }
 }

@@ -1,0 +1,167 @@
+//! The generators' geometry, not only their counts: positions, sizes and contacts follow
+//! from each construction, and the expected values are worked out here.
+
+use raylab_core::Vec3;
+use raylab_procedural::{generate, Size};
+
+fn size(size: u32) -> Size {
+    Size { size, strands: 0, segments: 0 }
+}
+
+/// The spheres of a generated scene, `(centre, radius)` in file order.
+fn spheres(toml: &str) -> Vec<(Vec3, f32)> {
+    let value = |line: &str| line.split_once('=').unwrap().1.trim().to_string();
+    let mut out = Vec::new();
+    let mut centre = None;
+    for line in toml.lines() {
+        if line.starts_with("center =") {
+            let v: Vec<f32> = value(line).trim_matches(['[', ']']).split(',').map(|s| s.trim().parse().unwrap()).collect();
+            centre = Some(Vec3::new(v[0], v[1], v[2]));
+        } else if line.starts_with("radius =") {
+            out.push((centre.take().expect("radius after centre"), value(line).parse().unwrap()));
+        }
+    }
+    out
+}
+
+/// Vertices and 1-based triangle faces of an OBJ text.
+fn obj(text: &str) -> (Vec<Vec3>, Vec<[usize; 3]>) {
+    let (mut v, mut f) = (Vec::new(), Vec::new());
+    for line in text.lines() {
+        let t: Vec<&str> = line.split_whitespace().collect();
+        match t.first() {
+            Some(&"v") => v.push(Vec3::new(t[1].parse().unwrap(), t[2].parse().unwrap(), t[3].parse().unwrap())),
+            Some(&"f") => f.push([t[1].parse().unwrap(), t[2].parse().unwrap(), t[3].parse().unwrap()]),
+            _ => {}
+        }
+    }
+    (v, f)
+}
+
+#[test]
+fn sphereflake_children_touch_their_parent() {
+    let s = spheres(&generate("balls", size(1), "").unwrap().toml);
+    assert_eq!(s.len(), 10);
+    assert_eq!(s[0], (Vec3::ZERO, 1.0));
+    // Nine children of radius 1/3 resting on the unit sphere: centres at 1 + 1/3 from the origin;
+    // six on the equator (y = 0, 60° apart), three on the cap at 0.6 rad from +y.
+    let children = &s[1..];
+    for (c, r) in children {
+        assert!((r - 1.0 / 3.0).abs() < 1e-6 && (c.length() - 4.0 / 3.0).abs() < 1e-5, "{c} {r}");
+    }
+    for k in 0..6 {
+        let (a, b) = (children[k].0, children[(k + 1) % 6].0);
+        assert!(a.y.abs() < 1e-5, "{a}");
+        assert!((a.angle_between(b) - std::f32::consts::FRAC_PI_3).abs() < 1e-5);
+    }
+    for (c, _) in &children[6..] {
+        assert!((c.y - 4.0 / 3.0 * 0.6f32.cos()).abs() < 1e-5, "{c}");
+    }
+    // No two children overlap.
+    for i in 0..9 {
+        for j in i + 1..9 {
+            assert!(children[i].0.distance(children[j].0) >= 2.0 / 3.0 - 1e-5, "{i} {j}");
+        }
+    }
+    // Depth 2: every grandchild (radius 1/9) touches one child.
+    let s = spheres(&generate("balls", size(2), "").unwrap().toml);
+    let (kids, grandkids): (Vec<_>, Vec<_>) = s[1..].iter().partition(|(_, r)| (r - 1.0 / 3.0).abs() < 1e-6);
+    assert_eq!((kids.len(), grandkids.len()), (9, 81));
+    for (g, r) in &grandkids {
+        assert!((r - 1.0 / 9.0).abs() < 1e-6);
+        assert!(kids.iter().any(|(k, _)| (k.distance(*g) - (1.0 / 3.0 + 1.0 / 9.0)).abs() < 1e-5), "{g} touches no child");
+    }
+}
+
+#[test]
+fn rings_sit_on_their_circles() {
+    let s = spheres(&generate("rings", size(3), "").unwrap().toml);
+    assert_eq!(s.len(), 12 + 24 + 36);
+    // Ring i: 12i spheres of radius π·2i/(12i) = π/6 on the circle of radius 2i, lifted to r + 0.2i.
+    let mut start = 0;
+    for ring in 1..=3 {
+        let count = 12 * ring;
+        for (c, r) in &s[start..start + count] {
+            let r_expected = std::f32::consts::PI / 6.0;
+            assert!((r - r_expected).abs() < 1e-6);
+            assert!(((c.x * c.x + c.z * c.z).sqrt() - 2.0 * ring as f32).abs() < 1e-5, "ring {ring}: {c}");
+            assert!((c.y - (r_expected + 0.2 * ring as f32)).abs() < 1e-5);
+        }
+        start += count;
+    }
+}
+
+#[test]
+fn sierpinski_tetrahedron_keeps_its_surface_area_and_bounds() {
+    for depth in 1..=3 {
+        let g = generate("tetra", size(depth), "t.obj").unwrap();
+        let (v, f) = obj(&g.side_file.unwrap());
+        assert_eq!(f.len(), 4usize.pow(depth + 1));
+        // Each level halves the edges and quadruples the tetrahedra: the total area stays that
+        // of the unit-corner tetrahedron, 4 · (√3/4)(2√2)² = 8√3.
+        let area: f32 = f.iter().map(|t| 0.5 * (v[t[1] - 1] - v[t[0] - 1]).cross(v[t[2] - 1] - v[t[0] - 1]).length()).sum();
+        assert!((area - 8.0 * 3f32.sqrt()).abs() < 1e-3, "depth {depth}: area {area}");
+        // Every edge is 2√2 / 2^depth long and every vertex inside the corners' cube [−1, 1]³.
+        let edge = 2.0 * 2f32.sqrt() / (1 << depth) as f32;
+        for t in &f {
+            for k in 0..3 {
+                assert!((v[t[k] - 1].distance(v[t[(k + 1) % 3] - 1]) - edge).abs() < 1e-5);
+            }
+        }
+        assert!(v.iter().all(|p| p.abs().max_element() <= 1.0 + 1e-6));
+    }
+}
+
+#[test]
+fn mountain_is_a_height_field_over_the_square_facing_up() {
+    let g = generate("mount", size(3), "m.obj").unwrap();
+    let (v, f) = obj(&g.side_file.unwrap());
+    let n = 8;
+    assert_eq!((v.len(), f.len()), ((n + 1) * (n + 1), 2 * n * n));
+    // Grid vertices at x, z = −2 + 4i/n; the ground projection of the triangles tiles the 4 × 4 square.
+    for (i, p) in v.iter().enumerate() {
+        let (x, z) = (i % (n + 1), i / (n + 1));
+        assert_eq!((p.x, p.z), (x as f32 / n as f32 * 4.0 - 2.0, z as f32 / n as f32 * 4.0 - 2.0));
+        assert!(p.y >= -0.3 && p.y < 2.0, "{p}");
+    }
+    let mut projected = 0.0;
+    for t in &f {
+        let normal = (v[t[1] - 1] - v[t[0] - 1]).cross(v[t[2] - 1] - v[t[0] - 1]);
+        assert!(normal.y > 0.0, "face {t:?} faces down");
+        projected += 0.5 * normal.y;
+    }
+    assert!((projected - 16.0f32).abs() < 1e-4, "{projected}");
+    // The four spheres (radius 0.25) are in the scene as written.
+    assert_eq!(spheres(&g.toml).iter().filter(|(_, r)| *r == 0.25).count(), 4);
+}
+
+#[test]
+fn hair_strands_start_inside_the_ball_and_advance_in_equal_steps() {
+    let (strands, segments) = (40u32, 4u32);
+    let g = generate("hair", Size { size: 0, strands, segments }, "b.curves").unwrap();
+    let step = 0.6 / segments as f32;
+    let text = g.side_file.unwrap();
+    let mut points: Vec<Vec<(Vec3, f32)>> = Vec::new();
+    for line in text.lines().filter(|l| !l.starts_with('#')) {
+        if line == "strand" {
+            points.push(Vec::new());
+            continue;
+        }
+        let x: Vec<f32> = line.split(' ').map(|s| s.parse().unwrap()).collect();
+        points.last_mut().unwrap().push((Vec3::new(x[0], x[1], x[2]), x[3]));
+    }
+    assert_eq!(points.len(), strands as usize);
+    for (k, strand) in points.iter().enumerate() {
+        // The phantom point is one step inside the ball, on the Fibonacci lattice's normal:
+        // its height is (1 − step)(1 − 2(k + ½)/strands).
+        let (p0, r0) = strand[0];
+        assert!((p0.length() - (1.0 - step)).abs() < 1e-5, "strand {k}: {p0}");
+        assert!((p0.y - (1.0 - step) * (1.0 - 2.0 * (k as f32 + 0.5) / strands as f32)).abs() < 1e-5);
+        for w in strand.windows(2) {
+            assert!((w[0].0.distance(w[1].0) - step).abs() < 1e-5, "strand {k}: uneven step");
+        }
+        // Radii taper from the root's to a third of it at the tip (1 − 0.67).
+        let tip = strand.last().unwrap().1;
+        assert!((tip - 0.33 * r0).abs() < 1e-6 * r0.max(1.0), "strand {k}: {r0} → {tip}");
+    }
+}
