@@ -36,7 +36,7 @@ fn fails_with(args: &[&str], dir: &Path, message: &str) {
 #[test]
 fn the_bare_command_renders_the_default_scene() {
     let dir = scratch("default");
-    let o = raylab(&["render", "--width", "80", "--height", "60", "--spp", "1"], &dir);
+    let o = raylab(&["render", "--width", "80", "--height", "60", "--spp", "1", "--threads", "1"], &dir);
     assert!(o.status.success(), "{}", stderr(&o));
     let (w, h, pixels) = read_image(&dir.join("raylab.png"), true).unwrap();
     assert_eq!((w, h), (80, 60));
@@ -47,7 +47,9 @@ fn the_bare_command_renders_the_default_scene() {
     assert!(lum.len() > 50, "only {} distinct values", lum.len());
     let summary = stderr(&o);
     assert!(summary.contains("Rendered the default scene at 80×60, 1 spp"), "{summary}");
-    assert!(summary.contains("Mrays/s"), "{summary}");
+    assert!(summary.contains("Mrays/s on 1 thread)"), "{summary}");
+    // Without -o the default output is replaced: the summary says so.
+    assert!(summary.contains("Wrote raylab.png (the default output, replaced if it existed; -o names another)"), "{summary}");
 }
 
 /// Mean squared error and largest absolute difference between two linear images.

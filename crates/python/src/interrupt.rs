@@ -2,9 +2,8 @@
 //! calling thread, holding the GIL only between short waits, polls Python's signal handlers:
 //! Ctrl-C raises `KeyboardInterrupt` within a tenth of a second however long the job is.
 //!
-//! The render loop has no cancel flag yet, so an interrupted job finishes in the background
-//! and its result is dropped. When the film/`render_tile` loop with a cancel flag lands,
-//! `Cancel::set` is where to raise it.
+//! An interrupted job is told through [`Cancel`]: renders stop at the next pass
+//! (`render_until`), benches and studies at the next render.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{channel, RecvTimeoutError};
@@ -17,14 +16,18 @@ use pyo3::prelude::*;
 /// How often the calling thread wakes to run Python's signal handlers.
 const POLL: Duration = Duration::from_millis(50);
 
-/// Set when the caller gave up on the job: jobs made of several renders or passes stop at
-/// the next one, and it is the hook for a render loop's cancel flag.
+/// Set when the caller gave up on the job: renders stop at the next pass, jobs made of
+/// several renders at the next one.
 #[derive(Clone, Default)]
 pub struct Cancel(Arc<AtomicBool>);
 
 impl Cancel {
     pub fn is_set(&self) -> bool {
         self.0.load(Ordering::Relaxed)
+    }
+    /// The flag itself, for the render loop's `cancel`.
+    pub fn flag(&self) -> &AtomicBool {
+        &self.0
     }
     fn set(&self) {
         self.0.store(true, Ordering::Relaxed);

@@ -30,7 +30,9 @@ pub fn load(path: Option<&std::path::Path>, o: &Overrides) -> PyResult<RScene> {
 /// for Ctrl-C.
 pub fn render_interruptible(py: Python<'_>, scene: Arc<RScene>, threads: Option<u32>) -> PyResult<RenderOutput> {
     let pool = settings::pool(threads)?;
-    interrupt::run(py, move |_cancel| settings::install(pool.as_ref(), || raylab_render::render(&scene, &|_| {})))
+    let out = interrupt::run(py, move |cancel| settings::install(pool.as_ref(), || raylab_render::render_until(&scene, &|_| {}, cancel.flag())))?;
+    // `None` only when cancelled, and then `run` has already returned the signal's exception.
+    out.ok_or_else(|| pyo3::exceptions::PyKeyboardInterrupt::new_err("render cancelled"))
 }
 
 /// The AOVs `Scene.render(aovs=...)` accepts: integrators that write one value per pixel.

@@ -86,6 +86,8 @@ pub fn merge(earlier: &Overrides, later: &Overrides) -> Overrides {
         accel: later.accel.or(earlier.accel),
         seed: later.seed.or(earlier.seed),
         filter: later.filter.or(earlier.filter),
+        build: later.build.clone().or_else(|| earlier.build.clone()),
+        lenient: later.lenient || earlier.lenient,
     }
 }
 

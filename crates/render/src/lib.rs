@@ -21,7 +21,7 @@ pub use integrator::IntegratorKind;
 pub use light::Light;
 pub use material::{Material, MaterialId, TexColor, TextureId};
 pub use film::{Crop, Film, FilmError, FilmHeader};
-pub use render::{render, render_tile, Control, RenderOutput, Stop};
+pub use render::{render, render_tile, render_until, Control, RenderOutput, Stop};
 pub use sampler::{PixelSampler, SamplerKind};
 pub use scene::{Background, RenderSettings, Scene, SurfaceHit};
 pub use shape::{Geometry, Sphere, TriangleMesh};

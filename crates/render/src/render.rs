@@ -67,17 +67,14 @@ pub enum Stop {
 
 /// The header of films of `scene` rendered with its settings in passes of `pass_samples`.
 pub fn film_header(scene: &Scene, pass_samples: u32) -> FilmHeader {
+    FilmHeader { scene_hash: scene_hash(scene), settings_hash: settings_hash(scene, pass_samples), ..memory_film_header(scene, pass_samples) }
+}
+
+/// The header of a film that never leaves the process (no checkpoint, no part file): its
+/// fingerprints are left at 0, since hashing a large scene costs time for nothing.
+pub fn memory_film_header(scene: &Scene, pass_samples: u32) -> FilmHeader {
     let s = &scene.settings;
-    FilmHeader {
-        width: s.width,
-        height: s.height,
-        spp: s.spp,
-        pass_samples,
-        scene_hash: scene_hash(scene),
-        settings_hash: settings_hash(scene, pass_samples),
-        version: VERSION.into(),
-        heatmap: s.integrator.is_heatmap(),
-    }
+    FilmHeader { width: s.width, height: s.height, spp: s.spp, pass_samples, scene_hash: 0, settings_hash: 0, version: VERSION.into(), heatmap: s.integrator.is_heatmap() }
 }
 
 /// A fingerprint of what the scene contains (not its settings): camera, geometry,
@@ -203,16 +200,24 @@ fn pixel_sums(scene: &Scene, x: u32, y: u32, samples: Range<u32>, c: &mut Counte
 /// wrapper of [`render_tile`]. `progress(pixels)` is called as tiles finish, once per pass,
 /// so it totals `width × height × passes`.
 pub fn render(scene: &Scene, progress: &(dyn Fn(u64) + Sync)) -> RenderOutput {
+    render_until(scene, progress, &AtomicBool::new(false)).expect("a render that is never cancelled completes")
+}
+
+/// [`render`] that stops when `cancel` is set (Python's Ctrl-C, a UI): `None` then, the
+/// image of the passes done being of no use to these callers.
+pub fn render_until(scene: &Scene, progress: &(dyn Fn(u64) + Sync), cancel: &AtomicBool) -> Option<RenderOutput> {
     let s = &scene.settings;
     let start = Instant::now();
     let empty = || RenderOutput { width: s.width, height: s.height, pixels: vec![Rgb::ZERO; s.width as usize * s.height as usize], counters: Counters::default(), nonfinite_samples: 0, seconds: 0.0 };
+    let header = memory_film_header(scene, DEFAULT_PASS_SAMPLES);
     // An empty image or no samples (settings the loader never produces): nothing to render.
-    let Ok(mut film) = Film::new(film_header(scene, DEFAULT_PASS_SAMPLES), Crop::full(s.width, s.height)) else { return empty() };
-    let never = AtomicBool::new(false);
-    let control = Control { cancel: &never, deadline: None, progress };
-    if render_tile(scene, &mut film, 0..s.spp, &control, |_| Ok::<(), FilmError>(())).is_err() {
-        return empty();
+    let Ok(mut film) = Film::new(header, Crop::full(s.width, s.height)) else { return Some(empty()) };
+    let control = Control { cancel, deadline: None, progress };
+    match render_tile(scene, &mut film, 0..s.spp, &control, |_| Ok::<(), FilmError>(())) {
+        Ok(Stop::Done) => {}
+        Ok(_) => return None,
+        Err(_) => return Some(empty()),
     }
     let seconds = start.elapsed().as_secs_f64();
-    RenderOutput { width: s.width, height: s.height, pixels: film.resolve(), counters: film.counters, nonfinite_samples: film.nonfinite_samples, seconds }
+    Some(RenderOutput { width: s.width, height: s.height, pixels: film.resolve(), counters: film.counters, nonfinite_samples: film.nonfinite_samples, seconds })
 }

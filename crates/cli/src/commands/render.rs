@@ -15,7 +15,7 @@ use raylab_accel::{Accel, Primitives};
 use raylab_render::film::atomic::{check_writable, write_atomic};
 use raylab_render::film::image_out::{self as image_io, Tonemap};
 use raylab_render::film::{Crop, Film, DEFAULT_PASS_SAMPLES};
-use raylab_render::render::{film_header, render_tile, Control, Stop};
+use raylab_render::render::{film_header, memory_film_header, render_tile, Control, Stop};
 
 use super::scene_args::SceneArgs;
 
@@ -237,7 +237,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         let scene = a.scene.load()?;
         let load_s = load_start.elapsed().as_secs_f64();
         let s = &scene.settings;
-        let header = film_header(&scene, a.pass_spp);
+        // Fingerprints only for films that leave the process (checkpoints, parts).
+        let keeps_film = a.checkpoint.is_some() || a.resume.is_some() || kind == OutputKind::Film;
+        let header = if keeps_film { film_header(&scene, a.pass_spp) } else { memory_film_header(&scene, a.pass_spp) };
         let crop = match (a.tile, a.crop) {
             (Some((i, n)), _) => Crop::tile(s.width, s.height, i, n).map_err(|e| anyhow!("--tile: {e}"))?,
             (None, Some(c)) => {
@@ -328,6 +330,8 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             "no pass completed, nothing written".to_string()
         } else if !written {
             format!("{} will be written when complete (samples {}..{} of {} held)", out.display(), held.start, held.end, s.spp)
+        } else if held.len() as u32 == s.spp && a.output.is_none() {
+            format!("Wrote {} (the default output, replaced if it existed; -o names another)", out.display())
         } else if held.len() as u32 == s.spp {
             format!("Wrote {}", out.display())
         } else {
@@ -340,7 +344,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             let part = if crop == Crop::full(s.width, s.height) { String::new() } else { format!(", crop {crop}") };
             eprintln!(
                 "Rendered {} at {}×{}{part}, {} spp ({}), integrator {}, max depth {}: {} primitives ({} triangles, {} spheres, {} curve segments, {} patches), {} lights; \
-                 {} acceleration structure built in {:.1} ms after {:.2} s of loading. Traced {:.2} M rays in {:.2} s ({:.2} Mrays/s on {threads} threads){}; per ray {:.1} nodes visited and {:.1} primitive tests. {wrote}{saved}.",
+                 {} acceleration structure built in {:.1} ms after {:.2} s of loading. Traced {:.2} M rays in {:.2} s ({:.2} Mrays/s on {threads} thread{}){}; per ray {:.1} nodes visited and {:.1} primitive tests. {wrote}{saved}.",
                 a.scene.scene_name(),
                 s.width,
                 s.height,
@@ -360,6 +364,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
                 c.rays as f64 / 1e6,
                 seconds,
                 mrays,
+                if threads == 1 { "" } else { "s" },
                 if film.nonfinite_samples > 0 { format!("; {} non-finite samples dropped", film.nonfinite_samples) } else { String::new() },
                 per_ray(c.nodes_visited),
                 per_ray(c.prim_tests),
