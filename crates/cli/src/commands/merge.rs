@@ -9,9 +9,10 @@ use std::time::Instant;
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
 use raylab_render::film::atomic::check_writable;
-use raylab_render::film::image_out::{self as image_io, Tonemap};
+use raylab_render::film::image_out as image_io;
 use raylab_render::film::{Crop, Film};
 
+use super::image_args::ImageArgs;
 use super::render::{read_film, write_film};
 
 #[derive(Args, Clone, Debug)]
@@ -22,12 +23,8 @@ pub struct MergeArgs {
     /// The merged image (.png, .ppm, .exr, .pfm) or film (.film, which may stay partial)
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Tone map for 8-bit outputs: clamp, reinhard or aces
-    #[arg(long, default_value = "clamp")]
-    pub tonemap: Tonemap,
-    /// Exposure in stops applied before tone mapping (-64 to 64)
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub exposure: f32,
+    #[command(flatten)]
+    pub image: ImageArgs,
     /// No summary
     #[arg(short, long)]
     pub quiet: bool,
@@ -39,7 +36,7 @@ pub fn run(a: &MergeArgs) -> Result<()> {
     if !to_film && !["png", "ppm", "exr", "pfm"].contains(&ext.as_str()) {
         bail!("{}: unknown output format `.{ext}` (valid: {}, film)", a.output.display(), image_io::image_format_names());
     }
-    image_io::check_exposure(a.exposure).map_err(|e| anyhow!("--exposure: {e}"))?;
+    a.image.check()?;
     check_writable(&a.output).map_err(|e| anyhow!("{e}"))?;
     let start = Instant::now();
     let parts = a.parts.iter().map(|p| read_film(p)).collect::<Result<Vec<_>>>()?;
@@ -58,7 +55,7 @@ pub fn run(a: &MergeArgs) -> Result<()> {
     if to_film {
         write_film(&a.output, &merged)?;
     } else {
-        image_io::write_image(&a.output, h.width, h.height, &merged.resolve(), a.tonemap, a.exposure)?;
+        a.image.write(&a.output, h.width, h.height, &merged.resolve())?;
     }
     if !a.quiet {
         let s = merged.samples();

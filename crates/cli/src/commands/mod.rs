@@ -3,6 +3,7 @@ pub mod bench;
 pub mod compare;
 pub mod converge;
 pub mod gen;
+pub mod image_args;
 pub mod inspect;
 pub mod merge;
 pub mod render;

@@ -13,10 +13,11 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use raylab_accel::{Accel, Primitives};
 use raylab_render::film::atomic::{check_writable, write_atomic};
-use raylab_render::film::image_out::{self as image_io, Tonemap};
+use raylab_render::film::image_out as image_io;
 use raylab_render::film::{Crop, Film, DEFAULT_PASS_SAMPLES};
 use raylab_render::render::{film_header, memory_film_header, render_tile, Control, Stop};
 
+use super::image_args::ImageArgs;
 use super::scene_args::SceneArgs;
 
 #[derive(Args, Clone, Debug, Default)]
@@ -27,12 +28,8 @@ pub struct RenderArgs {
     /// film (.film: the per-pixel sums, for `raylab merge`; required with --tile, --crop, --samples)
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-    /// Tone map for 8-bit outputs: clamp, reinhard or aces
-    #[arg(long, default_value = "clamp")]
-    pub tonemap: Tonemap,
-    /// Exposure in stops applied before tone mapping (-64 to 64)
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub exposure: f32,
+    #[command(flatten)]
+    pub image: ImageArgs,
     /// No progress bar or summary
     #[arg(short, long)]
     pub quiet: bool,
@@ -220,7 +217,7 @@ struct Summary<'a> {
 pub fn run(a: &RenderArgs) -> Result<()> {
     let out = a.output.clone().unwrap_or_else(crate::default_output);
     let kind = output_kind(&out)?;
-    image_io::check_exposure(a.exposure).map_err(|e| anyhow!("--exposure: {e}"))?;
+    a.image.check()?;
     let partial = a.tile.is_some() || a.crop.is_some() || a.samples.is_some();
     if partial && kind != OutputKind::Film {
         bail!("{}: --tile, --crop and --samples render part of the image: give -o PART.film (join the parts with `raylab merge`)", out.display());
@@ -293,7 +290,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         if written {
             match kind {
                 OutputKind::Film => write_film(&out, &film)?,
-                OutputKind::Image => image_io::write_image(&out, crop.width(), crop.height(), &film.resolve(), a.tonemap, a.exposure)?,
+                OutputKind::Image => a.image.write(&out, crop.width(), crop.height(), &film.resolve())?,
             }
         }
         let stopped = match stop {
