@@ -39,17 +39,19 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command {
-        None => commands::render::run(&commands::render::RenderArgs::default()),
-        Some(Command::Render(a)) => commands::render::run(&a),
-        Some(Command::Inspect(a)) => commands::inspect::run(&a),
-        Some(Command::Gen(a)) => commands::gen::run(&a),
-        Some(Command::Bench(a)) => commands::bench::run(&a),
-        Some(Command::Trace(a)) => commands::trace::run(&a),
-        Some(Command::Compare(a)) => commands::compare::run(&a),
-        Some(Command::Converge(a)) => commands::converge::run(&a),
-        Some(Command::Bake(a)) => commands::bake::run(&a),
-        Some(Command::Merge(a)) => commands::merge::run(&a),
+    // No command is `raylab render` with clap's defaults (a derived `Default` would give 0
+    // for the pass size and the checkpoint interval).
+    let command = cli.command.unwrap_or_else(|| Cli::parse_from(["raylab", "render"]).command.expect("`render` parses"));
+    let result = match command {
+        Command::Render(a) => commands::render::run(&a),
+        Command::Inspect(a) => commands::inspect::run(&a),
+        Command::Gen(a) => commands::gen::run(&a),
+        Command::Bench(a) => commands::bench::run(&a),
+        Command::Trace(a) => commands::trace::run(&a),
+        Command::Compare(a) => commands::compare::run(&a),
+        Command::Converge(a) => commands::converge::run(&a),
+        Command::Bake(a) => commands::bake::run(&a),
+        Command::Merge(a) => commands::merge::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

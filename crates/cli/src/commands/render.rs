@@ -20,7 +20,7 @@ use raylab_render::render::{film_header, memory_film_header, render_tile, Contro
 use super::image_args::ImageArgs;
 use super::scene_args::SceneArgs;
 
-#[derive(Args, Clone, Debug, Default)]
+#[derive(Args, Clone, Debug)]
 pub struct RenderArgs {
     #[command(flatten)]
     pub scene: SceneArgs,

@@ -118,6 +118,9 @@ impl FilmHeader {
     /// The passes covering sample range `samples`, which must start and end on pass boundaries.
     pub fn passes_of(&self, samples: &Range<u32>) -> Result<Range<u32>, FilmError> {
         let k = self.pass_samples;
+        if k == 0 {
+            return Err(FilmError::Invalid("the pass size must be at least 1 sample".into()));
+        }
         let aligned = |s: u32| s % k == 0 || s == self.spp;
         if samples.start >= samples.end || samples.end > self.spp || !aligned(samples.start) || !aligned(samples.end) {
             return Err(FilmError::Invalid(format!(
