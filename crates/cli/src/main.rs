@@ -38,11 +38,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
-    // No command is `raylab render` with clap's defaults (a derived `Default` would give 0
-    // for the pass size and the checkpoint interval).
-    let command = cli.command.unwrap_or_else(|| Cli::parse_from(["raylab", "render"]).command.expect("`render` parses"));
-    let result = match command {
+    let result = match command_of(Cli::parse()) {
         Command::Render(a) => commands::render::run(&a),
         Command::Inspect(a) => commands::inspect::run(&a),
         Command::Gen(a) => commands::gen::run(&a),
@@ -68,7 +64,28 @@ fn main() -> ExitCode {
     }
 }
 
+/// The command to run: none is `raylab render` with clap's defaults (a derived `Default`
+/// would give 0 for the pass size and the checkpoint interval).
+fn command_of(cli: Cli) -> Command {
+    cli.command.unwrap_or_else(|| Cli::parse_from(["raylab", "render"]).command.expect("`render` parses"))
+}
+
 /// Where an output image goes unless `-o` says otherwise.
 pub fn default_output() -> PathBuf {
     PathBuf::from("raylab.png")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The README's first command, `raylab` alone, once panicked: its options were a derived
+    /// `Default` with a pass size of 0. It must be exactly `raylab render`.
+    #[test]
+    fn no_command_is_render_with_its_defaults() {
+        let Command::Render(bare) = command_of(Cli::parse_from(["raylab"])) else { panic!("not render") };
+        let Some(Command::Render(render)) = Cli::parse_from(["raylab", "render"]).command else { panic!("not render") };
+        assert_eq!(format!("{bare:?}"), format!("{render:?}"));
+        assert_eq!(bare.pass_spp, raylab_render::film::DEFAULT_PASS_SAMPLES);
+    }
 }

@@ -33,18 +33,6 @@ fn fails_with(args: &[&str], dir: &Path, message: &str) {
     assert_eq!(err.trim_end(), format!("raylab: error: {message}"), "{args:?}");
 }
 
-/// `raylab` with no command at all: the README's first command. It once panicked (a derived
-/// `Default` of the render options gave a pass size of 0).
-#[test]
-fn raylab_with_no_arguments_renders_the_default_scene() {
-    let dir = scratch("no-arguments");
-    let o = raylab(&[], &dir);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let (w, h, _) = read_image(&dir.join("raylab.png"), true).unwrap();
-    assert_eq!((w, h), (640, 480));
-    assert!(stderr(&o).contains("Rendered the default scene at 640×480, 16 spp"), "{}", stderr(&o));
-}
-
 #[test]
 fn the_bare_command_renders_the_default_scene() {
     let dir = scratch("default");
