@@ -4,8 +4,8 @@
 //!   and at points of its edges; a sphere; a capsule-shaped curve) that escape it;
 //! - **self-intersections**: secondary rays spawned from a hit as the renderer spawns them
 //!   (`offset_ray_origin` on the shape's own error bound) that find their origin surface
-//!   again: any hit of a ray leaving a convex shape outwards, or a hit nearer than 1e-3 of
-//!   the shape's size for one leaving it inwards.
+//!   again: any hit of a ray leaving a convex shape outwards, or, for one leaving it
+//!   inwards, a hit on its origin primitive nearer than 1e-3 of the shape's size.
 //!
 //! Every shape is convex, so both counts are exact: the right answer is 0 in every cell.
 
@@ -123,7 +123,9 @@ pub fn measure_cell(kind: AccelKind, prims: PrimKind, scale: f32, rays: u64) -> 
             None => false,
             // Leaving a convex shape outwards, nothing is there to hit.
             Some(_) if k % 2 == 0 => true,
-            Some(h) => (h.t * dir).length() < 1e-3 * scale,
+            // Inwards, the far side (or, next to an edge, the neighbouring face at a grazing
+            // angle) is a genuine hit; the origin primitive found again close by is not.
+            Some(h) => h.prim == hit.prim && (h.t * dir).length() < 1e-3 * scale,
         };
         self_intersections += u64::from(bad);
     }
