@@ -282,8 +282,8 @@ mod tests {
 
     /// The table's target, on a few cells of every kind: no leaks, no self-intersections.
     /// Curves are the known exception (docs/robustness.md): rays leaving a strand inwards
-    /// near a segment's end find that end again (a hit at u = 0 or 1 within 1e-3 of the
-    /// radius), about 1 % of them at every scale; their leaks are still 0.
+    /// near a segment's end find that segment again (at u = 0 or 1, within 1e-3 of the
+    /// strand's size), about 1 % of them at every scale; their leaks are still 0.
     #[test]
     fn no_leaks_and_no_self_intersections() {
         let r = measure(&[AccelKind::None, AccelKind::Bvh, AccelKind::Grid, AccelKind::Bvh8], &[1e-4, 1.0, 1e5], 400);

@@ -66,3 +66,21 @@ pub fn table(r: &Robustness) -> String {
     out += &format!("\ntotal: {} leaks, {} self-intersections\n", r.total_leaks(), r.total_self_intersections());
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use raylab_accel::AccelKind;
+
+    #[test]
+    fn table_has_a_row_per_structure_and_kind_and_a_column_per_scale() {
+        let r = measure(&[AccelKind::Bvh], &SCALES, 20);
+        let t = table(&r);
+        let lines: Vec<&str> = t.lines().collect();
+        assert_eq!(lines[0], "leaks / self-intersections, 20 leak rays and 20 spawned rays per cell");
+        assert_eq!(lines[2], "| structure | primitives | 1e-4 | 1e-3 | 1e-2 | 1e-1 | 1e0 | 1e1 | 1e2 | 1e3 | 1e4 | 1e5 |");
+        assert_eq!(lines[4], "| bvh | triangles | 0 / 0 | 0 / 0 | 0 / 0 | 0 / 0 | 0 / 0 | 0 / 0 | 0 / 0 | 0 / 0 | 0 / 0 | 0 / 0 |");
+        assert!(lines[7].starts_with("| bvh | patches | - / 0 |"), "{}", lines[7]);
+        assert_eq!(lines.len(), 4 + 4 + 2);
+    }
+}
