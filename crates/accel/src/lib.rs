@@ -178,17 +178,36 @@ impl Default for BuildOptions {
 }
 
 /// Distance by which grids and kd-trees grow cells (or split planes) when they decide
-/// which side of a boundary a primitive or a ray is on: about 2⁻¹⁸ of the scene's largest
-/// coordinate, some thirty ulps. Rounding in a DDA step or a plane distance moves a point by
-/// a few ulps of the coordinates involved, so a primitive within the margin of a boundary is
-/// kept on both sides, and no hit is lost or taken from the wrong cell. Rays whose origin
-/// lies far outside the scene (beyond ~10⁴ scene sizes) are not covered by this bound.
+/// which side of a boundary a primitive or a ray is on, and BVHs of boxes or spheres grow
+/// their leaves. Rounding moves a point by two kinds of error, bounded separately:
+/// - arithmetic on distances within the scene (plane distances, `t` along a ray, clipping
+///   parameters) errs relative to the scene's size: 2⁻¹⁸ of its extent, some thirty ulps;
+/// - each operation that lands on an absolute coordinate (a ray point `o + t·d`, a cell
+///   boundary `min + k·size`) rounds by half an ulp of that coordinate; four such roundings
+///   per decision at most, so four ulps of the largest coordinate.
+///
+/// A primitive within the margin of a boundary is kept on both sides, so no hit is lost or
+/// taken from the wrong cell. The margin used to be 2⁻¹⁸ of the largest *coordinate*: a
+/// scene of size 20 shifted to 1e6 then grew every cell by 3.8, and the grid, kd-tree and
+/// the BVHs built on grown leaves did hundreds of times the work (issue 12). Rays whose
+/// origin lies far outside the scene (beyond ~10⁴ scene sizes) are not covered by this bound.
 pub(crate) fn robust_margin(scene: &Aabb) -> f32 {
     if scene.is_empty() {
         return f32::MIN_POSITIVE;
     }
-    let scale = scene.min.abs().max(scene.max.abs()).max_element().max(scene.extent().max_element());
-    (scale * (1.0 / 262_144.0)).max(f32::MIN_POSITIVE)
+    let largest_coordinate = scene.min.abs().max(scene.max.abs()).max_element();
+    leaf_margin(scene) + 4.0 * (largest_coordinate.next_up() - largest_coordinate)
+}
+
+/// The part of [`robust_margin`] that BVHs of boxes and spheres need for their leaves: their
+/// traversal only computes distances from the ray origin (`(bound - origin) / dir`, the
+/// offset to a sphere's centre), whose rounding is relative to those distances, never to the
+/// absolute coordinates, so 2⁻¹⁸ of the scene's extent covers it.
+pub(crate) fn leaf_margin(scene: &Aabb) -> f32 {
+    if scene.is_empty() {
+        return f32::MIN_POSITIVE;
+    }
+    (scene.extent().max_element() * (1.0 / 262_144.0)).max(f32::MIN_POSITIVE)
 }
 
 /// A built structure of any kind.

@@ -11,7 +11,7 @@ use raylab_core::{Aabb, BoundingSphere, Ray, Vec3};
 
 use crate::bvh::traverse::{any_in_tree, closest_in_tree, tree_stats, TreeNode};
 use crate::bvh::{lbvh, ploc, SahCost};
-use crate::{robust_margin, Accel, AccelStats, BuildOptions, Counters, Hit, Primitives, ValidationError};
+use crate::{leaf_margin, Accel, AccelStats, BuildOptions, Counters, Hit, Primitives, ValidationError};
 
 /// One node, 24 bytes: interior when `count == 0` (children at `left_first` and
 /// `left_first + 1`), else a leaf of `indices[left_first .. left_first + count]`.
@@ -56,7 +56,7 @@ impl SphereBvh {
     pub fn build<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions) -> Self {
         let n = prims.len();
         let bounds: Vec<Aabb> = (0..n as u32).into_par_iter().map(|i| prims.bounds(i)).collect();
-        let margin = robust_margin(&bounds.par_iter().copied().reduce(|| Aabb::EMPTY, Aabb::union));
+        let margin = leaf_margin(&bounds.par_iter().copied().reduce(|| Aabb::EMPTY, Aabb::union));
         // Each leaf sphere is grown by the margin: a ray through a box corner lies on the
         // sphere's surface, where rounding in the ray–sphere test could otherwise miss it.
         let spheres: Vec<BoundingSphere> = bounds

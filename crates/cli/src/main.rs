@@ -35,6 +35,8 @@ enum Command {
     Bake(commands::bake::BakeArgs),
     /// Join the films of tiles and sample ranges (render --tile/--crop/--samples) into one image
     Merge(commands::merge::MergeArgs),
+    /// Measure leaks and self-intersections of every structure and primitive kind at scales 1e-4..1e5
+    Robustness(commands::robustness::RobustnessArgs),
 }
 
 fn main() -> ExitCode {
@@ -48,6 +50,7 @@ fn main() -> ExitCode {
         Command::Converge(a) => commands::converge::run(&a),
         Command::Bake(a) => commands::bake::run(&a),
         Command::Merge(a) => commands::merge::run(&a),
+        Command::Robustness(a) => commands::robustness::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

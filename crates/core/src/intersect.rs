@@ -94,26 +94,86 @@ impl ShearedRay {
         let t_scaled = u * az + v * bz + w * cz;
         let inv_det = 1.0 / det;
         let t = t_scaled * inv_det;
-        if !(t > t_min && t <= t_max) {
-            return None;
-        }
         // A hit this close to the origin may be rounding error of a ray leaving this very
         // triangle: reject t below its error bound (pbrt-v4 §6.8.4), which is what makes the
-        // tiny offsets of `offset_ray_origin` safe.
+        // tiny offsets of `offset_ray_origin` safe. The bound grows with the vertices'
+        // distance from the origin, not with t: on a huge triangle (a ±1e6 floor) a ray from
+        // just above it has its true hit below the single-precision bound, so there t is
+        // recomputed in double precision, whose bound is 2^29 times smaller. The choice
+        // depends only on the ray and the triangle (never on t_max), so every structure and
+        // the oracle get the same t whatever order they test triangles in.
         let max_zt = az.abs().max(bz.abs()).max(cz.abs());
         let max_xt = ax.abs().max(bx.abs()).max(cx.abs());
         let max_yt = ay.abs().max(by.abs()).max(cy.abs());
-        let delta_z = gamma(3) * max_zt;
-        let delta_x = gamma(5) * (max_xt + max_zt);
-        let delta_y = gamma(5) * (max_yt + max_zt);
-        let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
         let max_e = u.abs().max(v.abs()).max(w.abs());
-        let delta_t = 3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
-        if t <= delta_t {
+        let delta_t = t_error_bound(max_xt, max_yt, max_zt, max_e, inv_det.abs(), gamma);
+        let t = if t > delta_t {
+            t
+        } else if t < -delta_t {
+            return None;
+        } else {
+            self.triangle_t_f64(p0, p1, p2)?
+        };
+        if !(t > t_min && t <= t_max) {
             return None;
         }
         Some((t, v * inv_det, w * inv_det))
     }
+
+    /// The distance to the plane of `p0 p1 p2` in double precision (the arithmetic of
+    /// [`ShearedRay::triangle`] on the same shear), or `None`
+    /// when it is within its own error bound of zero or behind the origin: the fallback for
+    /// hits too close for the single-precision bound to decide.
+    #[cold]
+    fn triangle_t_f64(&self, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<f32> {
+        let (kx, ky, kz) = (self.kx, self.ky, self.kz);
+        // The single-precision shear constants define the transform the edge functions used;
+        // their rounding only turns the ray by an ulp about its origin, which changes t by
+        // an ulp of t, not of the vertices' distance as the f32 arithmetic does.
+        let (sx, sy, sz) = (self.sx as f64, self.sy as f64, self.sz as f64);
+        let o = self.origin.as_dvec3();
+        let (a, b, c) = (p0.as_dvec3() - o, p1.as_dvec3() - o, p2.as_dvec3() - o);
+        let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
+        let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
+        let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        let det = u + v + w;
+        if det == 0.0 {
+            return None;
+        }
+        let (az, bz, cz) = (sz * a[kz], sz * b[kz], sz * c[kz]);
+        let inv_det = 1.0 / det;
+        let t = (u * az + v * bz + w * cz) * inv_det;
+        let max_zt = az.abs().max(bz.abs()).max(cz.abs());
+        let max_xt = ax.abs().max(bx.abs()).max(cx.abs());
+        let max_yt = ay.abs().max(by.abs()).max(cy.abs());
+        let max_e = u.abs().max(v.abs()).max(w.abs());
+        let delta_t = t_error_bound(max_xt, max_yt, max_zt, max_e, inv_det.abs(), gamma_f64);
+        (t > delta_t).then_some(t as f32)
+    }
+}
+
+/// pbrt-v4's conservative bound (§6.8.4) on the absolute error of the watertight kernel's
+/// `t`, from the largest sheared coordinates and edge function, in the precision of `T`
+/// with its `γₙ`.
+#[inline(always)]
+fn t_error_bound<T>(max_xt: T, max_yt: T, max_zt: T, max_e: T, inv_det_abs: T, gamma: fn(u32) -> T) -> T
+where
+    T: Copy + std::ops::Add<Output = T> + std::ops::Mul<Output = T> + From<f32>,
+{
+    let delta_z = gamma(3) * max_zt;
+    let delta_x = gamma(5) * (max_xt + max_zt);
+    let delta_y = gamma(5) * (max_yt + max_zt);
+    let delta_e = T::from(2.0) * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+    T::from(3.0) * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det_abs
+}
+
+/// [`gamma`] in double precision.
+fn gamma_f64(n: u32) -> f64 {
+    let e = f64::EPSILON * 0.5;
+    (n as f64 * e) / (1.0 - n as f64 * e)
 }
 
 /// Ray–sphere intersection, nearest root in `(ray.t_min, ray.t_max]`.

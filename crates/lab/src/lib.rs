@@ -7,6 +7,7 @@ pub mod bake;
 pub mod converge;
 pub mod rayfile;
 pub mod report;
+pub mod robustness;
 pub mod rays;
 pub mod trace;
 

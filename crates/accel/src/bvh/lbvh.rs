@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use raylab_core::{Aabb, BoundingSphere, Vec3};
 
 use super::{Bvh, BvhNode, SahCost, MAX_DEPTH};
-use crate::{robust_margin, BuildOptions, Primitives};
+use crate::{leaf_margin, BuildOptions, Primitives};
 
 /// Bits per axis of a Morton code: 3 × 10 = 30 bits fit a `u32`.
 pub const MORTON_BITS: u32 = 10;
@@ -240,14 +240,14 @@ pub fn build<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions) -> Bvh {
     from_tree(tree, n, "lbvh", opts)
 }
 
-/// The primitives' boxes grown by [`robust_margin`]. The shared BVH traversal prunes a box
+/// The primitives' boxes grown by [`leaf_margin`]. The shared BVH traversal prunes a box
 /// whose entry distance exceeds the closest hit so far; for a primitive lying in its box's
 /// face (coplanar triangles, axis-aligned quads) the two distances are equal in exact
 /// arithmetic, and rounding could prune the box holding the truly closest hit. Grown
 /// boxes are entered a margin earlier, so such ties always resolve towards visiting.
 pub(crate) fn grown_bounds<P: Primitives + ?Sized>(prims: &P) -> Vec<Aabb> {
     let bounds: Vec<Aabb> = (0..prims.len() as u32).into_par_iter().map(|i| prims.bounds(i)).collect();
-    let m = robust_margin(&bounds.par_iter().copied().reduce(|| Aabb::EMPTY, Aabb::union));
+    let m = leaf_margin(&bounds.par_iter().copied().reduce(|| Aabb::EMPTY, Aabb::union));
     bounds.into_par_iter().map(|b| Aabb { min: b.min - m, max: b.max + m }).collect()
 }
 

@@ -14,7 +14,7 @@
 use raylab_core::Aabb;
 
 use super::{Bvh, BvhNode, SahCost, MAX_DEPTH};
-use crate::{robust_margin, BuildOptions, Primitives};
+use crate::{leaf_margin, BuildOptions, Primitives};
 
 /// Duplicate references allowed, as a fraction of the primitive count. Stich et al. bound
 /// duplication by `α` alone; a budget (as in Embree's spatial-split builder) also bounds
@@ -60,7 +60,7 @@ pub fn build<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions) -> Bvh {
         max_leaf: opts.max_leaf_size.max(1),
         bins: opts.bins.clamp(2, 256),
         min_overlap: opts.spatial_split_alpha * root.half_area(),
-        margin: robust_margin(&root),
+        margin: leaf_margin(&root),
         nodes: Vec::new(),
         indices: Vec::new(),
     };

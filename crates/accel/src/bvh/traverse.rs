@@ -6,6 +6,7 @@ use raylab_core::{Ray, Vec3};
 
 use super::{Bvh, BvhNode, MAX_DEPTH};
 use crate::leaf::{any_hit, Closest};
+use crate::wide::kernels::ROBUST_FAR;
 use crate::{Accel, AccelStats, Counters, Hit, Primitives, ValidationError};
 
 impl Accel for Bvh {
@@ -73,9 +74,13 @@ impl TreeNode for BvhNode {
     fn count(&self) -> usize {
         self.count as usize
     }
+    /// Against `t_max` widened by `1 + 2γ₃`, as the wide traversal does: the triangles
+    /// around a vertex hit at distances an ulp apart, and the box of the nearer one may
+    /// round its entry above the farther hit; pruning it returned a hit an ulp behind the
+    /// oracle's (issue 12).
     #[inline]
     fn entry(&self, ray: &Ray, inv_dir: Vec3) -> Option<f32> {
-        self.bounds().intersect(ray.origin, inv_dir, ray.t_min, ray.t_max).map(|(t, _)| t)
+        self.bounds().intersect(ray.origin, inv_dir, ray.t_min, ray.t_max * ROBUST_FAR).map(|(t, _)| t)
     }
 }
 

@@ -7,5 +7,6 @@ pub mod image_args;
 pub mod inspect;
 pub mod merge;
 pub mod render;
+pub mod robustness;
 pub mod scene_args;
 pub mod trace;

@@ -44,10 +44,16 @@ impl SphericalRect {
         }
         let (x0, y0) = (d.dot(x), d.dot(y));
         let (x1, y1) = (x0 + exl, y0 + eyl);
-        let v00 = Vec3::new(x0, y0, z0);
-        let v01 = Vec3::new(x0, y1, z0);
-        let v10 = Vec3::new(x1, y0, z0);
-        let v11 = Vec3::new(x1, y1, z0);
+        // The corners' directions, scaled to about unit size: the normals below need only
+        // directions, and the cross products of unscaled corners square their lengths,
+        // which overflows f32 beyond ~1e19 (a rect light in a scene of scale 1e10 rendered
+        // black: |v × v|² = 1e40 = ∞, normalised to zero) and underflows below ~1e-19.
+        let size = x0.abs().max(x1.abs()).max(y0.abs()).max(y1.abs()).max(z0.abs());
+        let k = if size > 0.0 && size.is_finite() { 1.0 / size } else { 1.0 };
+        let v00 = Vec3::new(x0, y0, z0) * k;
+        let v01 = Vec3::new(x0, y1, z0) * k;
+        let v10 = Vec3::new(x1, y0, z0) * k;
+        let v11 = Vec3::new(x1, y1, z0) * k;
         let n0 = v00.cross(v10).normalize_or_zero();
         let n1 = v10.cross(v11).normalize_or_zero();
         let n2 = v11.cross(v01).normalize_or_zero();
@@ -87,6 +93,17 @@ mod tests {
         let r = SphericalRect::new(Vec3::ZERO, Vec3::new(-a, d, -a), Vec3::new(2.0 * a, 0.0, 0.0), Vec3::new(0.0, 0.0, 2.0 * a));
         let expected = 4.0 * (a * a / (a * a + d * d)).asin();
         assert!((r.solid_angle - expected).abs() < 1e-5, "{} against {expected}", r.solid_angle);
+    }
+
+    #[test]
+    fn solid_angle_does_not_depend_on_the_scene_scale() {
+        // The same configuration scaled by 1e-12..1e15: the solid angle is scale-free.
+        let at = |s: f32| SphericalRect::new(Vec3::splat(0.3) * s, Vec3::new(-0.5, 2.0, -0.5) * s, Vec3::new(1.0, 0.0, 0.0) * s, Vec3::new(0.0, 0.0, 1.0) * s).solid_angle;
+        let unit = at(1.0);
+        assert!(unit > 0.1, "{unit}");
+        for s in [1e-12f32, 1e-10, 1e-5, 1e5, 1e9, 1e10, 1e12, 1e15] {
+            assert!((at(s) - unit).abs() <= 1e-4 * unit, "scale {s}: {} against {unit}", at(s));
+        }
     }
 
     #[test]

@@ -1,0 +1,86 @@
+//! `raylab robustness`: leaks and self-intersections of every structure and primitive kind
+//! at scene scales 1e-4..1e5 (the measurement is `raylab_lab::robustness`; this prints it).
+
+use anyhow::{bail, Result};
+use clap::Args;
+use raylab_lab::robustness::{measure, PrimKind, Robustness, SCALES};
+
+use super::bench::parse_accels;
+
+#[derive(Args, Clone, Debug)]
+pub struct RobustnessArgs {
+    /// Leak rays and spawned rays per cell (structure × primitive kind × scale); the
+    /// target of issue 12 is 1000000 (about an hour on 2 cores for the whole table)
+    #[arg(long, default_value_t = 10_000)]
+    pub rays: u64,
+    /// Structures to measure: a comma-separated list, or "all"
+    #[arg(long, default_value = "all")]
+    pub accels: String,
+    /// Print JSON instead of the table
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(a: &RobustnessArgs) -> Result<()> {
+    if a.rays == 0 {
+        bail!("--rays: expected at least 1");
+    }
+    let kinds = parse_accels(&a.accels)?;
+    let r = measure(&kinds, &SCALES, a.rays);
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&r)?);
+    } else {
+        print!("{}", table(&r));
+    }
+    Ok(())
+}
+
+/// A Markdown table: one row per structure and primitive kind, one column per scale, each
+/// cell `leaks / self-intersections` (`-` for leaks where the shape has no inside).
+pub fn table(r: &Robustness) -> String {
+    let mut out = format!("leaks / self-intersections, {} leak rays and {} spawned rays per cell\n\n", r.rays_per_cell, r.rays_per_cell);
+    out += "| structure | primitives |";
+    for s in SCALES {
+        out += &format!(" {s:e} |");
+    }
+    out += "\n|---|---|";
+    out += &"---|".repeat(SCALES.len());
+    out += "\n";
+    let mut rows: Vec<(&str, PrimKind)> = Vec::new();
+    for c in &r.cells {
+        if !rows.contains(&(c.accel, c.prims)) {
+            rows.push((c.accel, c.prims));
+        }
+    }
+    for (accel, prims) in rows {
+        out += &format!("| {accel} | {} |", prims.name());
+        for s in SCALES {
+            match r.cells.iter().find(|c| c.accel == accel && c.prims == prims && c.scale == s) {
+                Some(c) if prims.has_leak_test() => out += &format!(" {} / {} |", c.leaks, c.self_intersections),
+                Some(c) => out += &format!(" - / {} |", c.self_intersections),
+                None => out += " |",
+            }
+        }
+        out += "\n";
+    }
+    out += &format!("\ntotal: {} leaks, {} self-intersections\n", r.total_leaks(), r.total_self_intersections());
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use raylab_accel::AccelKind;
+
+    #[test]
+    fn table_has_a_row_per_structure_and_kind_and_a_column_per_scale() {
+        let r = measure(&[AccelKind::Bvh], &SCALES, 20);
+        let t = table(&r);
+        let lines: Vec<&str> = t.lines().collect();
+        assert_eq!(lines[0], "leaks / self-intersections, 20 leak rays and 20 spawned rays per cell");
+        assert_eq!(lines[2], "| structure | primitives | 1e-4 | 1e-3 | 1e-2 | 1e-1 | 1e0 | 1e1 | 1e2 | 1e3 | 1e4 | 1e5 |");
+        assert_eq!(lines[4], "| bvh | triangles | 0 / 0 | 0 / 0 | 0 / 0 | 0 / 0 | 0 / 0 | 0 / 0 | 0 / 0 | 0 / 0 | 0 / 0 | 0 / 0 |");
+        assert!(lines[7].starts_with("| bvh | patches | - / 0 |"), "{}", lines[7]);
+        assert_eq!(lines.len(), 4 + 4 + 2);
+    }
+}
