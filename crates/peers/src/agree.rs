@@ -8,8 +8,10 @@
 //! - a ray agrees when both miss, or both hit at distances within [`REL_T_TOLERANCE`]
 //!   (relative; a different primitive at the same distance is the other side of a shared
 //!   edge and agrees); for any-hit rays, when both say the same;
-//! - at most [`DISAGREEING_PER_RAY`] of the rays (1 in 10,000, rounded up) may disagree;
-//!   beyond that the benchmark fails loudly, printing the first disagreement.
+//! - at most [`DISAGREEING_PER_RAY`] of the rays (1 in 2,000, rounded up) may disagree;
+//!   beyond that the benchmark fails loudly, printing the first disagreement. The most seen
+//!   (docs/performance.md) is 1.5 in 10,000: obvhs's CWBVH on the 871k dragon's shadow
+//!   rays, which leave the surface and cross its edges; a traversal bug breaks far more.
 
 use crate::PeerHit;
 
@@ -18,7 +20,7 @@ use crate::PeerHit;
 pub const REL_T_TOLERANCE: f32 = 1e-4;
 
 /// Fraction of rays allowed to disagree (rays through shared edges and vertices).
-pub const DISAGREEING_PER_RAY: f64 = 1e-4;
+pub const DISAGREEING_PER_RAY: f64 = 5e-4;
 
 /// One structure's answers against the reference's, for one ray set.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
@@ -110,9 +112,9 @@ mod tests {
 
     #[test]
     fn near_distances_and_shared_edges_agree_others_are_counted() {
-        // 20,000 rays: 2 may disagree (1 in 10,000).
-        let mut reference = vec![None; 20_000];
-        let mut got = vec![None; 20_000];
+        // 4,000 rays: 2 may disagree (1 in 2,000).
+        let mut reference = vec![None; 4_000];
+        let mut got = vec![None; 4_000];
         reference[0] = hit(2.0, 7);
         got[0] = hit(2.0 * (1.0 + 5e-5), 7); // within 1e-4 relative
         reference[1] = hit(3.0, 8);

@@ -19,19 +19,38 @@ pub struct Row {
     pub speeds: Vec<Option<Speed>>,
 }
 
-/// `speed / reference` from CPU-time rates (wall clock where CPU time is unavailable):
-/// above 1, the structure is faster than the reference.
-pub fn ratio(speed: Speed, reference: Speed) -> f64 {
-    if speed.mrays_cpu > 0.0 && reference.mrays_cpu > 0.0 {
-        speed.mrays_cpu / reference.mrays_cpu
-    } else {
-        speed.mrays_wall / reference.mrays_wall
+/// Which rate a table shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Clock {
+    Cpu,
+    Wall,
+}
+
+impl Speed {
+    /// The rate by `clock`; CPU time falls back to wall clock where it is unavailable (0).
+    pub fn rate(self, clock: Clock) -> f64 {
+        match clock {
+            Clock::Cpu if self.mrays_cpu > 0.0 => self.mrays_cpu,
+            _ => self.mrays_wall,
+        }
     }
 }
 
-/// A Markdown table: per ray kind, `CPU Mrays/s (ratio to reference)`; the reference row
-/// reads `1.00x`; without a reference row the ratios are left out.
-pub fn speed_table(kinds: &[&str], rows: &[Row], reference: &str) -> String {
+/// `speed / reference` by CPU-time rates (wall clock where CPU time is unavailable):
+/// above 1, the structure is faster than the reference.
+pub fn ratio(speed: Speed, reference: Speed) -> f64 {
+    ratio_by(speed, reference, Clock::Cpu)
+}
+
+fn ratio_by(speed: Speed, reference: Speed, clock: Clock) -> f64 {
+    let cpu = clock == Clock::Cpu && speed.mrays_cpu > 0.0 && reference.mrays_cpu > 0.0;
+    let clock = if cpu { Clock::Cpu } else { Clock::Wall };
+    speed.rate(clock) / reference.rate(clock)
+}
+
+/// A Markdown table: per ray kind, `Mrays/s (ratio to reference)` by `clock`; the
+/// reference row reads `1.00x`; without a reference row the ratios are left out.
+pub fn speed_table(kinds: &[&str], rows: &[Row], reference: &str, clock: Clock) -> String {
     let refs = rows.iter().find(|r| r.structure == reference);
     let mut s = String::from("| structure |");
     for k in kinds {
@@ -45,8 +64,8 @@ pub fn speed_table(kinds: &[&str], rows: &[Row], reference: &str) -> String {
         for (j, speed) in r.speeds.iter().enumerate() {
             let cell = match (speed, refs.and_then(|x| x.speeds[j])) {
                 (None, _) => "—".to_string(),
-                (Some(v), Some(base)) => format!("{:.2} ({:.2}x)", v.mrays_cpu, ratio(*v, base)),
-                (Some(v), None) => format!("{:.2}", v.mrays_cpu),
+                (Some(v), Some(base)) => format!("{:.2} ({:.2}x)", v.rate(clock), ratio_by(*v, base, clock)),
+                (Some(v), None) => format!("{:.2}", v.rate(clock)),
             };
             let _ = write!(s, " {cell} |");
         }
@@ -69,13 +88,15 @@ mod tests {
             Row { structure: "embree".into(), speeds: vec![sp(10.0), sp(4.0), None] },
             Row { structure: "raylab bvh8".into(), speeds: vec![sp(5.3), sp(5.0), sp(3.0)] },
         ];
-        let t = speed_table(&["primary", "diffuse", "packets"], &rows, "embree");
+        let t = speed_table(&["primary", "diffuse", "packets"], &rows, "embree", Clock::Cpu);
         assert_eq!(
             t,
             "| structure | primary | diffuse | packets |\n|---|---|---|---|\n\
              | embree | 10.00 (1.00x) | 4.00 (1.00x) | — |\n\
              | raylab bvh8 | 5.30 (0.53x) | 5.00 (1.25x) | 3.00 |\n"
         );
+        let t = speed_table(&["primary", "diffuse", "packets"], &rows[1..], "embree", Clock::Wall);
+        assert!(t.ends_with("| raylab bvh8 | 10.60 | 10.00 | 6.00 |\n"), "{t}");
         // Without CPU time the wall-clock rates give the ratio.
         let w = |x| Speed { mrays_wall: x, mrays_cpu: 0.0 };
         assert_eq!(ratio(w(3.0), w(12.0)), 0.25);
