@@ -87,21 +87,21 @@ impl PeerKind {
         }
     }
 
-    /// The cargo feature that builds this peer.
+    /// The feature of the `raylab` command that builds this peer (`peers` turns on this
+    /// crate's `obvhs` and `bvh`).
     pub fn feature(self) -> &'static str {
         match self {
             PeerKind::Embree | PeerKind::EmbreeMedium => "embree",
-            PeerKind::ObvhsCwbvh | PeerKind::ObvhsBvh2 => "obvhs",
-            PeerKind::BvhCrate => "bvh",
+            PeerKind::ObvhsCwbvh | PeerKind::ObvhsBvh2 | PeerKind::BvhCrate => "peers",
         }
     }
 
     /// Whether this build of raylab has the peer.
     pub fn available(self) -> bool {
-        match self.feature() {
-            "embree" => cfg!(feature = "embree"),
-            "obvhs" => cfg!(feature = "obvhs"),
-            _ => cfg!(feature = "bvh"),
+        match self {
+            PeerKind::Embree | PeerKind::EmbreeMedium => cfg!(feature = "embree"),
+            PeerKind::ObvhsCwbvh | PeerKind::ObvhsBvh2 => cfg!(feature = "obvhs"),
+            PeerKind::BvhCrate => cfg!(feature = "bvh"),
         }
     }
 
@@ -183,6 +183,9 @@ mod tests {
         if all.iter().all(|k| k.available()) {
             assert_eq!(parse_list("embree,obvhs,bvh").unwrap(), all.to_vec());
             assert_eq!(parse_list("obvhs-cwbvh, obvhs").unwrap(), vec![PeerKind::ObvhsCwbvh, PeerKind::ObvhsBvh2]);
+        }
+        if !PeerKind::BvhCrate.available() {
+            assert_eq!(parse_list("bvh").unwrap_err().to_string(), "--peers: `bvh-crate` is not in this build of raylab; build it with `cargo build --release -p raylab --features peers` (scripts/peers.sh installs libembree-dev and runs the whole comparison)");
         }
         if !PeerKind::Embree.available() {
             let e = parse_list("embree").unwrap_err();

@@ -132,7 +132,7 @@ fn bench_scene(a: &BenchArgs, path: Option<&PathBuf>, accels: &[AccelKind], peer
         None => raylab_loader::default_scene(&o)?,
     };
     let prims = &scene.geometry;
-    let tris: Vec<[Vec3; 3]> = (0..prims.len() as u32).map(|i| prims.triangle(i).ok_or(raylab_peers::PeerError::NotATriangle(i))).collect::<Result<_, _>>().with_context(|| format!("{name}"))?;
+    let tris: Vec<[Vec3; 3]> = (0..prims.len() as u32).map(|i| prims.triangle(i).ok_or(raylab_peers::PeerError::NotATriangle(i))).collect::<Result<_, _>>().with_context(|| name.clone())?;
     let mesh_bytes: usize = prims.meshes.iter().map(|m| m.positions.len() * 12 + m.indices.len() * 12).sum();
     let height = ((a.resolution as f64 * scene.settings.height as f64 / scene.settings.width as f64).round() as u32).max(1);
     let oracle_kind = if prims.len() <= a.oracle_limit { AccelKind::None } else { AccelKind::Bvh };
