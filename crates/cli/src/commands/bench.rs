@@ -55,6 +55,10 @@ pub struct BenchArgs {
     /// Seed of the diffuse and shadow rays
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Other engines' structures to trace side by side with raylab's: embree, obvhs, bvh
+    /// (needs a build with `--features peers,embree`; see scripts/peers.sh)
+    #[arg(long)]
+    pub peers: Option<String>,
 }
 
 pub fn parse_accels(list: &str) -> Result<Vec<AccelKind>> {
@@ -72,6 +76,9 @@ pub fn cpu_name() -> String {
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
+    if let Some(peers) = &a.peers {
+        return super::bench_peers::run(a, peers);
+    }
     let accels = parse_accels(&a.accels)?;
     // The outputs are checked before the (long) benchmark, not after it.
     for p in a.json.iter().chain(&a.report) {
