@@ -222,3 +222,71 @@ fn gltf_nodes_camera_light_and_material_map_as_documented() {
         other => panic!("{other:?}"),
     }
 }
+
+/// A 1×1 PNG of one 8-bit colour, as exporters embed images.
+fn png_1x1(rgb: [u8; 3]) -> Vec<u8> {
+    let mut out = Vec::new();
+    image::ImageEncoder::write_image(image::codecs::png::PngEncoder::new(&mut out), &rgb, 1, 1, image::ExtendedColorType::Rgb8).unwrap();
+    out
+}
+
+/// A hand-written glTF with everything embedded as base64 `data:` URIs (buffer and images),
+/// a base-colour texture and a normal texture: the normal map is read linear (not as sRGB)
+/// and becomes the material's tangent-space normal map; the base colour is decoded from sRGB.
+#[test]
+fn gltf_data_uris_and_normal_textures() {
+    let dir = std::env::temp_dir().join(format!("raylab_gltf_data_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let positions: Vec<u8> = [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    let uvs: Vec<u8> = [[0f32, 1.0], [1.0, 1.0], [0.0, 0.0]].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    let buffer = base64::encode([positions, uvs].concat());
+    let (flat, colour) = (base64::encode(png_1x1([128, 128, 255])), base64::encode(png_1x1([188, 188, 188])));
+    let json = format!(
+        r#"{{
+      "asset": {{"version": "2.0"}},
+      "scenes": [{{"nodes": [0]}}],
+      "nodes": [{{"mesh": 0}}],
+      "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}, "material": 0}}]}}],
+      "materials": [{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}, "metallicFactor": 0}}, "normalTexture": {{"index": 1}}}}],
+      "textures": [{{"source": 0}}, {{"source": 1}}],
+      "images": [{{"uri": "data:image/png;base64,{colour}"}}, {{"uri": "data:image/png;base64,{flat}"}}],
+      "buffers": [{{"uri": "data:application/octet-stream;base64,{buffer}", "byteLength": 60}}],
+      "bufferViews": [{{"buffer": 0, "byteLength": 36}}, {{"buffer": 0, "byteOffset": 36, "byteLength": 24}}],
+      "accessors": [
+        {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}},
+        {{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}}
+      ]
+    }}"#
+    );
+    std::fs::write(dir.join("embedded.gltf"), &json).unwrap();
+    let s = load_scene_or_mesh(&dir.join("embedded.gltf"), &Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
+    let mesh = &s.geometry.meshes[0];
+    assert_eq!(mesh.positions, vec![Vec3::ZERO, Vec3::X, Vec3::Y]);
+    // glTF's v runs down: flipped on load.
+    assert_eq!(mesh.uvs, vec![raylab_core::Vec2::new(0.0, 0.0), raylab_core::Vec2::new(1.0, 0.0), raylab_core::Vec2::new(0.0, 1.0)]);
+    assert_eq!(mesh.tangents.len(), 3, "a tangent-space normal map needs tangents, computed from the UVs");
+    let m = mesh.material.0 as usize;
+    let texel = |id: raylab_render::TextureId| match &s.textures[id.0 as usize] {
+        raylab_render::Texture::Image(i) => i.texels()[0],
+        other => panic!("{other:?}"),
+    };
+    match s.material_perturbations[m] {
+        Some(raylab_render::shading::ShadingPerturbation::NormalMap { texture, space: raylab_render::shading::NormalSpace::Tangent }) => {
+            assert_eq!(texel(texture), Rgb::new(128.0 / 255.0, 128.0 / 255.0, 1.0), "normal maps are linear data");
+        }
+        ref other => panic!("{other:?}"),
+    }
+    match &s.materials[m] {
+        // metallic 0 and the default roughness 1: diffuse.
+        raylab_render::Material::Diffuse { albedo: raylab_render::material::TexColor::Texture(t) } => {
+            // sRGB 188 is linear 0.5029.
+            assert!((texel(*t).x - 0.5029).abs() < 1e-3, "{}", texel(*t));
+        }
+        other => panic!("{other:?}"),
+    }
+    // Percent-encoded data URIs are not base64: said plainly.
+    std::fs::write(dir.join("plain.gltf"), json.replace(&format!("data:application/octet-stream;base64,{buffer}"), "data:text/plain,abc")).unwrap();
+    let e = load_scene_or_mesh(&dir.join("plain.gltf"), &Overrides::default()).unwrap_err().to_string();
+    assert_eq!(e, format!("{}: buffers[0]: only base64 data URIs are supported, found `data:text/plain,...`", dir.join("plain.gltf").display()));
+    std::fs::remove_dir_all(&dir).ok();
+}
