@@ -290,3 +290,37 @@ fn gltf_data_uris_and_normal_textures() {
     assert_eq!(e, format!("{}: buffers[0]: only base64 data URIs are supported, found `data:text/plain,...`", dir.join("plain.gltf").display()));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// pbrt-v4's `infinite` light with a `filename`: an equal-area octahedral square in the
+/// light's space, resampled into raylab's equirectangular map of the world. The map is red
+/// on the light's +z hemisphere (the square's central diamond) and blue on the other; under
+/// `Rotate -90 1 0 0` the light's +z is the world's +y, so the sky is red and the ground blue.
+#[test]
+fn pbrt_infinite_light_maps_are_equal_area_squares() {
+    let dir = std::env::temp_dir().join(format!("raylab_pbrt_env_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let side = 32u32;
+    let texels: Vec<u8> = (0..side * side)
+        .flat_map(|k| {
+            let (u, v) = (((k % side) as f32 + 0.5) / side as f32 * 2.0 - 1.0, ((k / side) as f32 + 0.5) / side as f32 * 2.0 - 1.0);
+            if u.abs() + v.abs() < 1.0 { [255, 0, 0] } else { [0, 0, 255] }
+        })
+        .collect();
+    image::save_buffer(dir.join("sky.png"), &texels, side, side, image::ExtendedColorType::Rgb8).unwrap();
+    image::save_buffer(dir.join("wide.png"), &texels, 2 * side, side / 2, image::ExtendedColorType::Rgb8).unwrap();
+    let scene = |file: &str| format!("LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\nWorldBegin\nAttributeBegin\nRotate -90 1 0 0\nLightSource \"infinite\" \"string filename\" \"{file}\"\nAttributeEnd\nShape \"sphere\" \"float radius\" 1\n");
+    std::fs::write(dir.join("env.pbrt"), scene("sky.png")).unwrap();
+    let desc = raylab_loader::pbrt::parse_pbrt(&dir.join("env.pbrt"), false).unwrap_or_else(|e| panic!("{e}"));
+    let env = desc.environment.expect("an environment light");
+    // (Not at the exact poles, where the equirect map's repeat wrap blends the first and last rows.)
+    assert_eq!(env.radiance(Vec3::new(0.1, 0.99, 0.05).normalize()), Rgb::X);
+    assert_eq!(env.radiance(Vec3::new(-0.1, -0.99, 0.05).normalize()), Rgb::Z);
+    assert_eq!(env.radiance(Vec3::new(0.3, 0.9, -0.3).normalize()), Rgb::X);
+    assert_eq!(env.radiance(Vec3::new(-0.5, -0.6, 0.2).normalize()), Rgb::Z);
+    // Below the horizon though towards the world's +z (the light's +z, were the rotation ignored).
+    assert_eq!(env.radiance(Vec3::new(0.05, -0.3, 0.95).normalize()), Rgb::Z);
+    std::fs::write(dir.join("wide.pbrt"), scene("wide.png")).unwrap();
+    let e = raylab_loader::pbrt::parse_pbrt(&dir.join("wide.pbrt"), false).unwrap_err().to_string();
+    assert_eq!(e, format!("{}:6: LightSource: wide.png: pbrt-v4 environment maps are equal-area octahedral squares, this image is 64×16 (pbrt-v4's `imgtool makeequiarea` converts an equirectangular map)", dir.join("wide.pbrt").display()));
+    std::fs::remove_dir_all(&dir).ok();
+}
