@@ -15,6 +15,11 @@ use raylab_render::filter::PixelFilter;
 use raylab_render::integrator::MisHeuristic;
 use raylab_render::{IntegratorKind, SamplerKind, Scene};
 
+/// `--accel`'s help: every structure's name, from the one list.
+fn accel_help() -> String {
+    format!("Acceleration structure by name: {} (none: the brute-force oracle; default bvh8)", AccelKind::names())
+}
+
 /// A clap parser for the integer setting `key`, in the settings table's range.
 fn ranged(key: &str) -> clap::builder::RangedI64ValueParser<u32> {
     let (min, max) = raylab_render::settings::spec(key).and_then(|s| s.range()).expect("an integer setting");
@@ -57,8 +62,8 @@ pub struct SettingsArgs {
     /// Integrator (lighting: whitted, direct, path; AOVs: normals, albedo, depth; statistics: heatmap, heatmap-tests)
     #[arg(long, value_enum)]
     pub integrator: Option<IntegratorKind>,
-    /// Acceleration structure by name: none (the brute-force oracle), bvh, kdtree, grid, sbvh, ... (an unknown name lists them all)
-    #[arg(long)]
+    /// Acceleration structure by name (`none` is the brute-force oracle)
+    #[arg(long, help = accel_help())]
     pub accel: Option<String>,
     /// Largest leaf of the acceleration structure's build (default 8)
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=255))]
