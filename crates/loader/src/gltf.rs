@@ -2,7 +2,7 @@
 //! the default scene's node hierarchy and transforms, triangle meshes (positions, normals,
 //! first UV set), the metallic-roughness material mapped to raylab's materials (table in
 //! `docs/scene-format.md`), base-colour and (tangent-space) normal textures, perspective
-//! cameras and `KHR_lights_punctual`; buffers and images in files, in the GLB's binary
+//! cameras and `KHR_lights_punctual` (point, directional, spot); buffers and images in files, in the GLB's binary
 //! chunk or in base64 `data:` URIs. Without a camera the model is framed as a bare mesh is.
 
 use std::collections::HashMap;
@@ -86,7 +86,15 @@ pub fn parse_gltf(path: &Path) -> Result<SceneDescription, LoadError> {
                 gltf::khr_lights_punctual::Kind::Point => Light::Point { position: world.transform_point3(Vec3::ZERO), intensity: c },
                 // Lux is an irradiance.
                 gltf::khr_lights_punctual::Kind::Directional => Light::Directional { direction: world.transform_vector3(-Vec3::Z).normalize(), irradiance: c },
-                gltf::khr_lights_punctual::Kind::Spot { .. } => return Err(LoadError::new(path, None, field, "spot lights are not supported (point and directional are)")),
+                // Candela within the cone, along the node's -z; the extension's defaults are
+                // an inner cone of 0 and an outer one of π/4.
+                gltf::khr_lights_punctual::Kind::Spot { inner_cone_angle, outer_cone_angle } => Light::Spot {
+                    position: world.transform_point3(Vec3::ZERO),
+                    direction: world.transform_vector3(-Vec3::Z).normalize(),
+                    intensity: c,
+                    cos_inner: inner_cone_angle.cos(),
+                    cos_outer: outer_cone_angle.cos(),
+                },
             });
         }
         stack.extend(node.children().map(|c| (c, world)));

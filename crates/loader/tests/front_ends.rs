@@ -324,3 +324,40 @@ fn pbrt_infinite_light_maps_are_equal_area_squares() {
     assert_eq!(e, format!("{}:6: LightSource: wide.png: pbrt-v4 environment maps are equal-area octahedral squares, this image is 64×16 (pbrt-v4's `imgtool makeequiarea` converts an equirectangular map)", dir.join("wide.pbrt").display()));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A `KHR_lights_punctual` spot light on a node turned to face down: a `Light::Spot` at the
+/// node, along its -z, with the file's cone angles; it lights a point straight below like a
+/// point light of the same intensity.
+#[test]
+fn gltf_spot_lights_shine_along_the_nodes_minus_z() {
+    let dir = std::env::temp_dir().join(format!("raylab_gltf_spot_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bin: Vec<u8> = [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    let json = format!(
+        r#"{{
+      "asset": {{"version": "2.0"}},
+      "extensionsUsed": ["KHR_lights_punctual"],
+      "extensions": {{"KHR_lights_punctual": {{"lights": [{{"type": "spot", "color": [1, 1, 1], "intensity": 8, "spot": {{"innerConeAngle": 0.3, "outerConeAngle": 0.6}}}}]}}}},
+      "scenes": [{{"nodes": [0, 1]}}],
+      "nodes": [
+        {{"mesh": 0}},
+        {{"translation": [0, 2, 0], "rotation": [-0.70710677, 0, 0, 0.70710677], "extensions": {{"KHR_lights_punctual": {{"light": 0}}}}}}
+      ],
+      "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
+      "buffers": [{{"uri": "data:application/octet-stream;base64,{}", "byteLength": 36}}],
+      "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
+      "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}}]
+    }}"#,
+        base64::encode(&bin)
+    );
+    std::fs::write(dir.join("spot.gltf"), json).unwrap();
+    let s = load_scene_or_mesh(&dir.join("spot.gltf"), &Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(s.lights.len(), 1, "the file's light replaces the framing light");
+    let raylab_render::Light::Spot { position, direction, intensity, cos_inner, cos_outer } = s.lights[0] else { panic!("{:?}", s.lights[0]) };
+    assert!((position - Vec3::new(0.0, 2.0, 0.0)).length() < 1e-6 && (direction + Vec3::Y).length() < 1e-6, "{position} {direction}");
+    assert_eq!((intensity, cos_inner, cos_outer), (Rgb::splat(8.0), 0.3f32.cos(), 0.6f32.cos()));
+    let below = s.lights[0].sample(Vec3::ZERO, 0, raylab_core::Vec2::ZERO).unwrap();
+    assert!((below.irradiance - Rgb::splat(2.0)).length() < 1e-5, "{}", below.irradiance);
+    assert!(s.lights[0].sample(Vec3::new(3.0, 1.9, 0.0), 0, raylab_core::Vec2::ZERO).is_none(), "outside the outer cone");
+}
