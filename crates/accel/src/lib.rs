@@ -143,6 +143,8 @@ impl FromStr for AccelKind {
     }
 }
 
+raylab_core::value_enum_from_names!(AccelKind);
+
 /// Build parameters shared by the builders; each reads the fields it needs.
 #[derive(Clone, Debug)]
 pub struct BuildOptions {

@@ -15,6 +15,10 @@ pub mod rng;
 pub mod sampling;
 pub mod transform;
 
+// For `named_enum!`'s `ValueEnum` impls, so that crates using it need no clap dependency.
+#[doc(hidden)]
+pub use clap as __clap;
+
 pub use bounds::{Aabb, BoundingSphere};
 pub use distribution::{Distribution1D, Distribution2D};
 pub use frame::Frame;

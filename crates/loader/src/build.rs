@@ -5,7 +5,7 @@ use raylab_render::{Camera, IntegratorKind, Light, RenderSettings, SamplerKind, 
 
 use crate::description::SceneDescription;
 use crate::error::LoadError;
-use crate::scene::Overrides;
+use raylab_render::Overrides;
 
 /// Settings: the defaults, then the description's, then the command line's.
 pub fn settings(desc: &SceneDescription, overrides: &Overrides) -> Result<RenderSettings, LoadError> {

@@ -14,7 +14,7 @@ use raylab_render::shading::ShadingPerturbation;
 use raylab_render::{Background, Geometry, Light, Material, MaterialId, Texture, TextureId};
 
 use crate::error::LoadError;
-use crate::scene::Overrides;
+use raylab_render::Overrides;
 
 /// Where a value came from: the file, its line, and the dotted field (`camera.at`,
 /// `Shape "sphere"`), for messages like `scene.toml:3: camera.at: must differ ...`.

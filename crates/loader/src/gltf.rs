@@ -1,8 +1,9 @@
 //! The glTF 2.0 front end (`.gltf` with its `.bin`, and `.glb`), through the `gltf` crate:
 //! the default scene's node hierarchy and transforms, triangle meshes (positions, normals,
 //! first UV set), the metallic-roughness material mapped to raylab's materials (table in
-//! `docs/scene-format.md`), base-colour textures, perspective cameras and
-//! `KHR_lights_punctual`. Without a camera the model is framed as a bare mesh is.
+//! `docs/scene-format.md`), base-colour and (tangent-space) normal textures, perspective
+//! cameras and `KHR_lights_punctual` (point, directional, spot); buffers and images in files, in the GLB's binary
+//! chunk or in base64 `data:` URIs. Without a camera the model is framed as a bare mesh is.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -10,6 +11,7 @@ use std::path::Path;
 use raylab_core::{Rgb, Transform, Vec2, Vec3};
 use raylab_render::bsdf::{Distribution, Geometry as MicrofacetGeometry};
 use raylab_render::material::TexColor;
+use raylab_render::shading::{NormalSpace, ShadingPerturbation};
 use raylab_render::texture::{Filter, ImageTexture, Wrap};
 use raylab_render::{Light, Material, MaterialId, Texture, TriangleMesh};
 
@@ -22,8 +24,8 @@ pub fn parse_gltf(path: &Path) -> Result<SceneDescription, LoadError> {
     let doc = gltf::Gltf::from_slice(&bytes).map_err(|e| LoadError::file(path, format!("not a valid glTF 2.0 file: {e}")))?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let read_uri = |what: &str, uri: &str| -> Result<Vec<u8>, LoadError> {
-        if uri.starts_with("data:") {
-            return Err(LoadError::new(path, None, what, "embedded data URIs are not supported: export as .glb or with a separate .bin"));
+        if let Some(data) = uri.strip_prefix("data:") {
+            return data_uri(data).map_err(|e| LoadError::new(path, None, what, e));
         }
         let file = base.join(uri.replace("%20", " "));
         std::fs::read(&file).map_err(|e| LoadError::new(path, None, what, format!("{}: cannot read: {e}", file.display())))
@@ -84,7 +86,15 @@ pub fn parse_gltf(path: &Path) -> Result<SceneDescription, LoadError> {
                 gltf::khr_lights_punctual::Kind::Point => Light::Point { position: world.transform_point3(Vec3::ZERO), intensity: c },
                 // Lux is an irradiance.
                 gltf::khr_lights_punctual::Kind::Directional => Light::Directional { direction: world.transform_vector3(-Vec3::Z).normalize(), irradiance: c },
-                gltf::khr_lights_punctual::Kind::Spot { .. } => return Err(LoadError::new(path, None, field, "spot lights are not supported (point and directional are)")),
+                // Candela within the cone, along the node's -z; the extension's defaults are
+                // an inner cone of 0 and an outer one of π/4.
+                gltf::khr_lights_punctual::Kind::Spot { inner_cone_angle, outer_cone_angle } => Light::Spot {
+                    position: world.transform_point3(Vec3::ZERO),
+                    direction: world.transform_vector3(-Vec3::Z).normalize(),
+                    intensity: c,
+                    cos_inner: inner_cone_angle.cos(),
+                    cos_outer: outer_cone_angle.cos(),
+                },
             });
         }
         stack.extend(node.children().map(|c| (c, world)));
@@ -124,6 +134,29 @@ pub fn parse_gltf(path: &Path) -> Result<SceneDescription, LoadError> {
     Ok(desc)
 }
 
+/// The bytes of a `data:` URI (after `data:`): `[<media type>];base64,<payload>`, as glTF
+/// exporters embed buffers and images.
+fn data_uri(data: &str) -> Result<Vec<u8>, String> {
+    let (header, payload) = data.split_once(',').ok_or("a data URI needs a `,` before its payload")?;
+    if !header.ends_with(";base64") {
+        return Err(format!("only base64 data URIs are supported, found `data:{header},...`"));
+    }
+    base64::decode(payload.trim()).map_err(|e| format!("the base64 payload of `data:{header},...` does not decode: {e}"))
+}
+
+/// An image texture of the file: decoded from sRGB for colours, linear for normal maps.
+fn image_texture(path: &Path, buffers: &[Vec<u8>], read_uri: &dyn Fn(&str, &str) -> Result<Vec<u8>, LoadError>, texture: gltf::Texture, srgb: bool, field: &str) -> Result<ImageTexture, LoadError> {
+    let bytes = match texture.source().source() {
+        gltf::image::Source::View { view, .. } => {
+            let buffer = &buffers[view.buffer().index()];
+            buffer.get(view.offset()..view.offset() + view.length()).ok_or_else(|| LoadError::new(path, None, field, format!("bufferViews[{}] runs past its buffer ({} bytes)", view.index(), buffer.len())))?.to_vec()
+        }
+        gltf::image::Source::Uri { uri, .. } => read_uri(field, uri)?,
+    };
+    let (w, h, texels) = crate::image_io::decode_image(path, &bytes, srgb).map_err(|e| LoadError::new(path, None, field, e.to_string()))?;
+    ImageTexture::new(w, h, texels, Wrap::Repeat, Filter::Bilinear).map_err(|e| LoadError::new(path, None, field, e.to_string()))
+}
+
 /// Maps a metallic-roughness material: a rough dielectric (metallic 0, roughness 1) is
 /// `diffuse`; anything else the glTF BRDF itself, `cooktorrance` with diffuse
 /// `base·(1 - metallic)`, `f0 = lerp(0.04, base, metallic)` and GGX α = roughness².
@@ -136,17 +169,11 @@ fn material(path: &Path, doc: &gltf::Gltf, buffers: &[Vec<u8>], read_uri: &dyn F
     let field = format!("materials[{k}]");
     let base_color = match pbr.base_color_texture() {
         Some(info) => {
-            let image = info.texture().source();
-            let bytes = match image.source() {
-                gltf::image::Source::View { view, .. } => buffers[view.buffer().index()][view.offset()..view.offset() + view.length()].to_vec(),
-                gltf::image::Source::Uri { uri, .. } => read_uri(&field, uri)?,
-            };
-            let (w, h, texels) = crate::image_io::decode_image(path, &bytes, true).map_err(|e| LoadError::new(path, None, field.clone(), e.to_string()))?;
+            let tex = image_texture(path, buffers, read_uri, info.texture(), true, &format!("{field}.baseColorTexture"))?;
             // The factor multiplies the texture; a white factor (the usual one) is the texture itself.
             if base != Rgb::ONE {
                 desc.warnings.push(format!("{}: {field}: baseColorFactor {base} times a texture is read as the texture alone", path.display()));
             }
-            let tex = ImageTexture::new(w, h, texels, Wrap::Repeat, Filter::Bilinear).map_err(|e| LoadError::new(path, None, field.clone(), e.to_string()))?;
             TexColor::Texture(desc.add_texture(format!("{field}.baseColorTexture"), Texture::Image(tex)))
         }
         None => TexColor::Constant(base),
@@ -162,5 +189,17 @@ fn material(path: &Path, doc: &gltf::Gltf, buffers: &[Vec<u8>], read_uri: &dyn F
         Material::CookTorrance { diffuse, specular: TexColor::Constant(Rgb::ONE), roughness: (roughness * roughness).max(1e-3), distribution: Distribution::Ggx, geometry: MicrofacetGeometry::Smith, f0: TexColor::Constant(f0) }
     };
     let name = m.name().map_or_else(|| field.clone(), str::to_string);
-    Ok(desc.add_material(name, material))
+    let id = desc.add_material(name, material);
+    // A tangent-space normal map, OpenGL's convention (+y up, as raylab's with glTF's v flipped
+    // on load); tangents come from the UVs (MikkTSpace's convention) when the mesh is built.
+    if let Some(normal) = m.normal_texture() {
+        let nfield = format!("{field}.normalTexture");
+        if normal.scale() != 1.0 {
+            desc.warnings.push(format!("{}: {nfield}: scale {} is read as 1", path.display(), normal.scale()));
+        }
+        let tex = image_texture(path, buffers, read_uri, normal.texture(), false, &nfield)?;
+        let texture = desc.add_texture(nfield, Texture::Image(tex));
+        desc.material_perturbations[id.0 as usize] = Some(ShadingPerturbation::NormalMap { texture, space: NormalSpace::Tangent });
+    }
+    Ok(id)
 }

@@ -525,7 +525,15 @@ impl Parser {
                 Some(file) => {
                     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
                     let found = Resolver::Disk { base }.find(&file).map_err(|tried| span.err(not_found_message(&file, &tried)))?;
-                    let (w, h, texels) = crate::image_io::read_image(&found.path(), false).map_err(|e| span.err(e.to_string()))?;
+                    // 8-bit images are sRGB-encoded, as pbrt-v4 reads them; EXR and PFM linear.
+                    let (w, h, texels) = crate::image_io::read_image(&found.path(), true).map_err(|e| span.err(e.to_string()))?;
+                    // pbrt-v4's maps are equal-area octahedral squares in the light's space:
+                    // resampled into raylab's equirectangular map of the world.
+                    if w != h {
+                        return Err(span.err(format!("{file}: pbrt-v4 environment maps are equal-area octahedral squares, this image is {w}×{h} (pbrt-v4's `imgtool makeequiarea` converts an equirectangular map)")));
+                    }
+                    let to_light = self.ctm.inv;
+                    let (w, h, texels) = crate::octahedral::to_equirect(w, &texels, |d| to_light.transform_vector3(d));
                     let image = ImageTexture::new(w, h, texels, Wrap::Repeat, Filter::Bilinear).map_err(|e| span.err(e.to_string()))?;
                     self.desc.environment = Some(EnvironmentLight::new(image, Rgb::splat(scale)));
                 }

@@ -3,19 +3,18 @@
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
-use raylab_accel::{AccelKind, BuildOptions};
 use raylab_core::{Rgb, Transform, Vec2, Vec3};
 use raylab_render::bsdf::{Distribution, Geometry as MicrofacetGeometry};
-use raylab_render::filter::PixelFilter;
-use raylab_render::integrator::MisHeuristic;
-use raylab_render::light::{EnvironmentLight, LightSampling, MAX_CELLS};
+use raylab_render::light::EnvironmentLight;
 use raylab_render::material::{TexColor, METALS};
 use raylab_render::shading::{NormalSpace, ShadingPerturbation};
 use raylab_render::shape::bezier_patch::DEFAULT_SUBDIVISIONS;
 use raylab_render::shape::{PatchSurfaces, DEFAULT_SEED_GRID};
 use raylab_render::shape::Sphere;
 use raylab_render::texture::{Checker, CheckerSpace, Filter, ImageTexture, Noise, NoiseKind, Wrap};
-use raylab_render::{Background, IntegratorKind, Light, Material, MaterialId, RenderSettings, SamplerKind, Scene, Texture, TriangleMesh};
+use raylab_render::settings::{SettingKind, SettingValue, SETTINGS};
+use raylab_render::{Background, Light, Material, MaterialId, Scene, Texture, TriangleMesh};
+pub use raylab_render::Overrides;
 
 use crate::description::{CameraDescription, SceneDescription, Span};
 
@@ -26,49 +25,10 @@ use crate::obj::{mtl_color, MtlMaterial};
 use crate::patches::{load_patch_mesh, load_patches_world};
 use crate::toml_read::{in_range, in_range_f32, positive, Doc, Table, Val};
 
-/// Values from the command line that replace the scene's before anything is built.
-#[derive(Clone, Debug, Default)]
-pub struct Overrides {
-    pub width: Option<u32>,
-    pub height: Option<u32>,
-    pub spp: Option<u32>,
-    pub max_depth: Option<u32>,
-    pub sampler: Option<SamplerKind>,
-    pub integrator: Option<IntegratorKind>,
-    pub light_sampling: Option<LightSampling>,
-    pub light_cells: Option<u32>,
-    pub mis_heuristic: Option<MisHeuristic>,
-    pub accel: Option<AccelKind>,
-    pub seed: Option<u64>,
-    pub filter: Option<PixelFilter>,
-    /// Parameters of the acceleration structure's build (SAH costs, leaf size, bins, ...).
-    pub build: Option<BuildOptions>,
-    /// Front ends warn about and skip what they do not support instead of failing (pbrt-v4
-    /// directives outside raylab's subset).
-    pub lenient: bool,
-}
-
-impl Overrides {
-    /// Replaces the settings the command line gave.
-    pub fn apply(&self, s: &mut RenderSettings) {
-        s.width = self.width.unwrap_or(s.width);
-        s.height = self.height.unwrap_or(s.height);
-        s.spp = self.spp.unwrap_or(s.spp);
-        s.max_depth = self.max_depth.unwrap_or(s.max_depth);
-        s.sampler = self.sampler.unwrap_or(s.sampler);
-        s.integrator = self.integrator.unwrap_or(s.integrator);
-        s.light_sampling = self.light_sampling.unwrap_or(s.light_sampling);
-        s.light_cells = self.light_cells.unwrap_or(s.light_cells);
-        s.mis_heuristic = self.mis_heuristic.unwrap_or(s.mis_heuristic);
-        s.accel = self.accel.unwrap_or(s.accel);
-        s.seed = self.seed.unwrap_or(s.seed);
-        s.filter = self.filter.unwrap_or(s.filter);
-    }
-}
-
 const TOP: &[&str] = &["camera", "render", "background", "textures", "materials", "shapes", "lights"];
 const CAMERA: &[&str] = &["from", "at", "up", "vfov", "width", "height", "aperture", "focus_distance"];
-const RENDER: &[&str] = &["spp", "sampler", "max_depth", "integrator", "light_sampling", "light_cells", "mis_heuristic", "accel", "seed", "filter"];
+/// The keys of `[render]`: the settings table's.
+static RENDER: std::sync::LazyLock<Vec<&'static str>> = std::sync::LazyLock::new(|| SETTINGS.iter().filter(|s| s.table == "render").map(|s| s.key).collect());
 const BACKGROUND: &[&str] = &["color", "texture"];
 const TEXTURE: &[&str] = &["name", "type", "file", "wrap", "filter", "srgb", "scale", "even", "odd", "space", "kind", "colors", "octaves", "seed", "color"];
 const MATERIAL: &[&str] = &[
@@ -145,51 +105,21 @@ struct Builder<'a> {
 }
 
 impl Builder<'_> {
-    /// The `[render]` table and the image size of `[camera]`, as the file gives them.
+    /// The `[render]` table and the image size of `[camera]`, as the file gives them: every
+    /// key of the settings table ([`SETTINGS`]) read the same way.
     fn settings(&self, top: &Table, desc: &mut SceneDescription) -> Result<(), LoadError> {
-        let s = &mut desc.settings;
-        if let Some(c) = top.get("camera") {
-            let c = c.table(CAMERA)?;
-            if let Some(v) = c.get("width") {
-                s.width = Some(in_range(&v, v.integer()?, 1, 16384)? as u32);
-            }
-            if let Some(v) = c.get("height") {
-                s.height = Some(in_range(&v, v.integer()?, 1, 16384)? as u32);
-            }
-        }
-        if let Some(r) = top.get("render") {
-            let r = r.table(RENDER)?;
-            if let Some(v) = r.get("spp") {
-                s.spp = Some(in_range(&v, v.integer()?, 1, 1 << 20)? as u32);
+        let render = top.get("render").map(|r| r.table(&RENDER)).transpose()?;
+        let camera = top.get("camera").map(|c| c.table(CAMERA)).transpose()?;
+        for spec in SETTINGS {
+            let table = if spec.table == "camera" { camera.as_ref() } else { render.as_ref() };
+            let Some(v) = table.and_then(|t| t.get(spec.key)) else { continue };
+            let value = match spec.kind {
+                SettingKind::Integer { .. } => SettingValue::Integer(v.integer()? as i128),
+                SettingKind::Name(_) => SettingValue::Name(v.str()?),
+            };
+            desc.settings.set(spec.key, value).map_err(|e| v.err(e))?;
+            if spec.key == "spp" {
                 desc.spp_span = Some(self.span(&v));
-            }
-            let s = &mut desc.settings;
-            if let Some(v) = r.get("sampler") {
-                s.sampler = Some(v.str()?.parse().map_err(|e: String| v.err(e))?);
-            }
-            if let Some(v) = r.get("max_depth") {
-                s.max_depth = Some(in_range(&v, v.integer()?, 1, 1024)? as u32);
-            }
-            if let Some(v) = r.get("integrator") {
-                s.integrator = Some(v.str()?.parse().map_err(|e: String| v.err(e))?);
-            }
-            if let Some(v) = r.get("light_sampling") {
-                s.light_sampling = Some(v.str()?.parse().map_err(|e: String| v.err(e))?);
-            }
-            if let Some(v) = r.get("mis_heuristic") {
-                s.mis_heuristic = Some(v.str()?.parse().map_err(|e: String| v.err(e))?);
-            }
-            if let Some(v) = r.get("light_cells") {
-                s.light_cells = Some(in_range(&v, v.integer()?, 1, MAX_CELLS as i64)? as u32);
-            }
-            if let Some(v) = r.get("accel") {
-                s.accel = Some(v.str()?.parse().map_err(|e: raylab_accel::UnknownAccel| v.err(e.to_string()))?);
-            }
-            if let Some(v) = r.get("filter") {
-                s.filter = Some(v.str()?.parse().map_err(|e: String| v.err(e))?);
-            }
-            if let Some(v) = r.get("seed") {
-                s.seed = Some(in_range(&v, v.integer()?, 0, i64::MAX)? as u64);
             }
         }
         Ok(())

@@ -222,3 +222,142 @@ fn gltf_nodes_camera_light_and_material_map_as_documented() {
         other => panic!("{other:?}"),
     }
 }
+
+/// A 1×1 PNG of one 8-bit colour, as exporters embed images.
+fn png_1x1(rgb: [u8; 3]) -> Vec<u8> {
+    let mut out = Vec::new();
+    image::ImageEncoder::write_image(image::codecs::png::PngEncoder::new(&mut out), &rgb, 1, 1, image::ExtendedColorType::Rgb8).unwrap();
+    out
+}
+
+/// A hand-written glTF with everything embedded as base64 `data:` URIs (buffer and images),
+/// a base-colour texture and a normal texture: the normal map is read linear (not as sRGB)
+/// and becomes the material's tangent-space normal map; the base colour is decoded from sRGB.
+#[test]
+fn gltf_data_uris_and_normal_textures() {
+    let dir = std::env::temp_dir().join(format!("raylab_gltf_data_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let positions: Vec<u8> = [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    let uvs: Vec<u8> = [[0f32, 1.0], [1.0, 1.0], [0.0, 0.0]].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    let buffer = base64::encode([positions, uvs].concat());
+    let (flat, colour) = (base64::encode(png_1x1([128, 128, 255])), base64::encode(png_1x1([188, 188, 188])));
+    let json = format!(
+        r#"{{
+      "asset": {{"version": "2.0"}},
+      "scenes": [{{"nodes": [0]}}],
+      "nodes": [{{"mesh": 0}}],
+      "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}, "material": 0}}]}}],
+      "materials": [{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}, "metallicFactor": 0}}, "normalTexture": {{"index": 1}}}}],
+      "textures": [{{"source": 0}}, {{"source": 1}}],
+      "images": [{{"uri": "data:image/png;base64,{colour}"}}, {{"uri": "data:image/png;base64,{flat}"}}],
+      "buffers": [{{"uri": "data:application/octet-stream;base64,{buffer}", "byteLength": 60}}],
+      "bufferViews": [{{"buffer": 0, "byteLength": 36}}, {{"buffer": 0, "byteOffset": 36, "byteLength": 24}}],
+      "accessors": [
+        {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}},
+        {{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}}
+      ]
+    }}"#
+    );
+    std::fs::write(dir.join("embedded.gltf"), &json).unwrap();
+    let s = load_scene_or_mesh(&dir.join("embedded.gltf"), &Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
+    let mesh = &s.geometry.meshes[0];
+    assert_eq!(mesh.positions, vec![Vec3::ZERO, Vec3::X, Vec3::Y]);
+    // glTF's v runs down: flipped on load.
+    assert_eq!(mesh.uvs, vec![raylab_core::Vec2::new(0.0, 0.0), raylab_core::Vec2::new(1.0, 0.0), raylab_core::Vec2::new(0.0, 1.0)]);
+    assert_eq!(mesh.tangents.len(), 3, "a tangent-space normal map needs tangents, computed from the UVs");
+    let m = mesh.material.0 as usize;
+    let texel = |id: raylab_render::TextureId| match &s.textures[id.0 as usize] {
+        raylab_render::Texture::Image(i) => i.texels()[0],
+        other => panic!("{other:?}"),
+    };
+    match s.material_perturbations[m] {
+        Some(raylab_render::shading::ShadingPerturbation::NormalMap { texture, space: raylab_render::shading::NormalSpace::Tangent }) => {
+            assert_eq!(texel(texture), Rgb::new(128.0 / 255.0, 128.0 / 255.0, 1.0), "normal maps are linear data");
+        }
+        ref other => panic!("{other:?}"),
+    }
+    match &s.materials[m] {
+        // metallic 0 and the default roughness 1: diffuse.
+        raylab_render::Material::Diffuse { albedo: raylab_render::material::TexColor::Texture(t) } => {
+            // sRGB 188 is linear 0.5029.
+            assert!((texel(*t).x - 0.5029).abs() < 1e-3, "{}", texel(*t));
+        }
+        other => panic!("{other:?}"),
+    }
+    // Percent-encoded data URIs are not base64: said plainly.
+    std::fs::write(dir.join("plain.gltf"), json.replace(&format!("data:application/octet-stream;base64,{buffer}"), "data:text/plain,abc")).unwrap();
+    let e = load_scene_or_mesh(&dir.join("plain.gltf"), &Overrides::default()).unwrap_err().to_string();
+    assert_eq!(e, format!("{}: buffers[0]: only base64 data URIs are supported, found `data:text/plain,...`", dir.join("plain.gltf").display()));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// pbrt-v4's `infinite` light with a `filename`: an equal-area octahedral square in the
+/// light's space, resampled into raylab's equirectangular map of the world. The map is red
+/// on the light's +z hemisphere (the square's central diamond) and blue on the other; under
+/// `Rotate -90 1 0 0` the light's +z is the world's +y, so the sky is red and the ground blue.
+#[test]
+fn pbrt_infinite_light_maps_are_equal_area_squares() {
+    let dir = std::env::temp_dir().join(format!("raylab_pbrt_env_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let side = 32u32;
+    let texels: Vec<u8> = (0..side * side)
+        .flat_map(|k| {
+            let (u, v) = (((k % side) as f32 + 0.5) / side as f32 * 2.0 - 1.0, ((k / side) as f32 + 0.5) / side as f32 * 2.0 - 1.0);
+            if u.abs() + v.abs() < 1.0 { [255, 0, 0] } else { [0, 0, 255] }
+        })
+        .collect();
+    image::save_buffer(dir.join("sky.png"), &texels, side, side, image::ExtendedColorType::Rgb8).unwrap();
+    image::save_buffer(dir.join("wide.png"), &texels, 2 * side, side / 2, image::ExtendedColorType::Rgb8).unwrap();
+    let scene = |file: &str| format!("LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\nWorldBegin\nAttributeBegin\nRotate -90 1 0 0\nLightSource \"infinite\" \"string filename\" \"{file}\"\nAttributeEnd\nShape \"sphere\" \"float radius\" 1\n");
+    std::fs::write(dir.join("env.pbrt"), scene("sky.png")).unwrap();
+    let desc = raylab_loader::pbrt::parse_pbrt(&dir.join("env.pbrt"), false).unwrap_or_else(|e| panic!("{e}"));
+    let env = desc.environment.expect("an environment light");
+    // (Not at the exact poles, where the equirect map's repeat wrap blends the first and last rows.)
+    assert_eq!(env.radiance(Vec3::new(0.1, 0.99, 0.05).normalize()), Rgb::X);
+    assert_eq!(env.radiance(Vec3::new(-0.1, -0.99, 0.05).normalize()), Rgb::Z);
+    assert_eq!(env.radiance(Vec3::new(0.3, 0.9, -0.3).normalize()), Rgb::X);
+    assert_eq!(env.radiance(Vec3::new(-0.5, -0.6, 0.2).normalize()), Rgb::Z);
+    // Below the horizon though towards the world's +z (the light's +z, were the rotation ignored).
+    assert_eq!(env.radiance(Vec3::new(0.05, -0.3, 0.95).normalize()), Rgb::Z);
+    std::fs::write(dir.join("wide.pbrt"), scene("wide.png")).unwrap();
+    let e = raylab_loader::pbrt::parse_pbrt(&dir.join("wide.pbrt"), false).unwrap_err().to_string();
+    assert_eq!(e, format!("{}:6: LightSource: wide.png: pbrt-v4 environment maps are equal-area octahedral squares, this image is 64×16 (pbrt-v4's `imgtool makeequiarea` converts an equirectangular map)", dir.join("wide.pbrt").display()));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A `KHR_lights_punctual` spot light on a node turned to face down: a `Light::Spot` at the
+/// node, along its -z, with the file's cone angles; it lights a point straight below like a
+/// point light of the same intensity.
+#[test]
+fn gltf_spot_lights_shine_along_the_nodes_minus_z() {
+    let dir = std::env::temp_dir().join(format!("raylab_gltf_spot_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bin: Vec<u8> = [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    let json = format!(
+        r#"{{
+      "asset": {{"version": "2.0"}},
+      "extensionsUsed": ["KHR_lights_punctual"],
+      "extensions": {{"KHR_lights_punctual": {{"lights": [{{"type": "spot", "color": [1, 1, 1], "intensity": 8, "spot": {{"innerConeAngle": 0.3, "outerConeAngle": 0.6}}}}]}}}},
+      "scenes": [{{"nodes": [0, 1]}}],
+      "nodes": [
+        {{"mesh": 0}},
+        {{"translation": [0, 2, 0], "rotation": [-0.70710677, 0, 0, 0.70710677], "extensions": {{"KHR_lights_punctual": {{"light": 0}}}}}}
+      ],
+      "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
+      "buffers": [{{"uri": "data:application/octet-stream;base64,{}", "byteLength": 36}}],
+      "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
+      "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}}]
+    }}"#,
+        base64::encode(&bin)
+    );
+    std::fs::write(dir.join("spot.gltf"), json).unwrap();
+    let s = load_scene_or_mesh(&dir.join("spot.gltf"), &Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(s.lights.len(), 1, "the file's light replaces the framing light");
+    let raylab_render::Light::Spot { position, direction, intensity, cos_inner, cos_outer } = s.lights[0] else { panic!("{:?}", s.lights[0]) };
+    assert!((position - Vec3::new(0.0, 2.0, 0.0)).length() < 1e-6 && (direction + Vec3::Y).length() < 1e-6, "{position} {direction}");
+    assert_eq!((intensity, cos_inner, cos_outer), (Rgb::splat(8.0), 0.3f32.cos(), 0.6f32.cos()));
+    let below = s.lights[0].sample(Vec3::ZERO, 0, raylab_core::Vec2::ZERO).unwrap();
+    assert!((below.irradiance - Rgb::splat(2.0)).length() < 1e-5, "{}", below.irradiance);
+    assert!(s.lights[0].sample(Vec3::new(3.0, 1.9, 0.0), 0, raylab_core::Vec2::ZERO).is_none(), "outside the outer cone");
+}

@@ -7,8 +7,9 @@ use std::sync::Arc;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use raylab_accel::{Accel, BuildOptions, Primitives};
+use raylab_accel::{Accel, Primitives};
 use raylab_loader::Overrides;
+use raylab_render::settings::{SettingValue, SETTINGS};
 use raylab_render::{IntegratorKind, RenderOutput, Scene as RScene};
 
 use crate::convert::{image_array, to_py};
@@ -102,18 +103,13 @@ impl Scene {
     fn settings<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let s = &self.inner.settings;
         let d = PyDict::new(py);
-        d.set_item("width", s.width)?;
-        d.set_item("height", s.height)?;
-        d.set_item("spp", s.spp)?;
-        d.set_item("sampler", s.sampler.name())?;
-        d.set_item("max_depth", s.max_depth)?;
-        d.set_item("integrator", s.integrator.name())?;
-        d.set_item("light_sampling", s.light_sampling.name())?;
-        d.set_item("light_cells", s.light_cells)?;
-        d.set_item("mis_heuristic", s.mis_heuristic.name())?;
-        d.set_item("accel", s.accel.name())?;
-        d.set_item("seed", s.seed)?;
-        d.set_item("filter", s.filter.name())?;
+        for spec in SETTINGS {
+            match s.get(spec.key) {
+                Some(SettingValue::Integer(n)) => d.set_item(spec.key, n)?,
+                Some(SettingValue::Name(name)) => d.set_item(spec.key, name)?,
+                None => {}
+            }
+        }
         d.set_item("threads", self.settings.threads)?;
         Ok(d)
     }
@@ -141,7 +137,7 @@ impl Scene {
             let scene = self.scene_mut(py)?;
             scene.settings = s;
             if rebuild {
-                py.detach(|| settings::install(pool.as_ref(), || scene.build_accel(&BuildOptions::default())));
+                py.detach(|| settings::install(pool.as_ref(), || scene.build_accel(&merged.build.clone().unwrap_or_default())));
             }
         }
         self.settings = Settings { overrides: merged, threads };

@@ -1,19 +1,21 @@
-//! Keyword arguments named like the CLI's flags (`spp=16`, `accel="bvh"`, `threads=4`),
-//! checked with the CLI's ranges and parsed with the library's own name parsers, so that a
-//! bad value gives the same message as `raylab render --spp 0` would.
+//! Keyword arguments named like the CLI's flags (`spp=16`, `accel="bvh"`, `threads=4`):
+//! the keys, ranges and names of the render crate's one settings table
+//! ([`raylab_render::settings::SETTINGS`]), so that a bad value gives the same message as
+//! `raylab render --spp 0` or a scene file would.
 
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use raylab_accel::AccelKind;
 use raylab_loader::Overrides;
-use raylab_render::filter::PixelFilter;
-use raylab_render::integrator::MisHeuristic;
-use raylab_render::light::LightSampling;
-use raylab_render::{IntegratorKind, SamplerKind};
+use raylab_render::settings::{SettingKind, SettingValue, SETTINGS};
 
-/// Every keyword `render`, `Scene` and `Scene.set` accept.
-pub const NAMES: &[&str] = &["spp", "width", "height", "max_depth", "sampler", "integrator", "light_sampling", "light_cells", "mis_heuristic", "accel", "seed", "filter", "threads"];
+/// Worker threads: a keyword beside the settings, not a scene setting.
+const THREADS: &str = "threads";
+
+/// Every keyword `render`, `Scene` and `Scene.set` accept: the settings table's, and `threads`.
+pub fn names() -> Vec<&'static str> {
+    SETTINGS.iter().map(|s| s.key).chain([THREADS]).collect()
+}
 
 /// Scene overrides plus the size of the thread pool, which is not a scene setting.
 #[derive(Clone, Debug, Default)]
@@ -32,12 +34,9 @@ fn int_in(name: &str, v: &Bound<'_, PyAny>, lo: u64, hi: u64) -> PyResult<u64> {
     }
 }
 
-fn name_of<T: std::str::FromStr>(name: &str, v: &Bound<'_, PyAny>) -> PyResult<T>
-where
-    T::Err: std::fmt::Display,
-{
-    let s: String = v.extract().map_err(|_| PyTypeError::new_err(format!("{name}: expected a string, found {}", v.get_type().name().map(|n| n.to_string()).unwrap_or_default())))?;
-    s.parse::<T>().map_err(|e| PyValueError::new_err(format!("{name}: {e}")))
+/// A name keyword: a string, or a `TypeError`.
+fn name_in(name: &str, v: &Bound<'_, PyAny>) -> PyResult<String> {
+    v.extract().map_err(|_| PyTypeError::new_err(format!("{name}: expected a string, found {}", v.get_type().name().map(|n| n.to_string()).unwrap_or_default())))
 }
 
 /// Parses `kwargs`; `caller` names the function in the error for an unknown keyword.
@@ -50,45 +49,25 @@ pub fn parse(caller: &str, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Setti
             // `spp=None` means "the scene's", as when the flag is left out.
             continue;
         }
-        let o = &mut s.overrides;
-        match key.as_str() {
-            "spp" => o.spp = Some(int_in("spp", &v, 1, 1 << 20)? as u32),
-            "width" => o.width = Some(int_in("width", &v, 1, 16384)? as u32),
-            "height" => o.height = Some(int_in("height", &v, 1, 16384)? as u32),
-            "max_depth" => o.max_depth = Some(int_in("max_depth", &v, 1, 1024)? as u32),
-            "light_cells" => o.light_cells = Some(int_in("light_cells", &v, 1, 16)? as u32),
-            "seed" => o.seed = Some(int_in("seed", &v, 0, u64::MAX)?),
-            "threads" => s.threads = Some(int_in("threads", &v, 1, 1024)? as u32),
-            "sampler" => o.sampler = Some(name_of::<SamplerKind>("sampler", &v)?),
-            "integrator" => o.integrator = Some(name_of::<IntegratorKind>("integrator", &v)?),
-            "light_sampling" => o.light_sampling = Some(name_of::<LightSampling>("light_sampling", &v)?),
-            "mis_heuristic" => o.mis_heuristic = Some(name_of::<MisHeuristic>("mis_heuristic", &v)?),
-            "accel" => o.accel = Some(name_of::<AccelKind>("accel", &v)?),
-            "filter" => o.filter = Some(name_of::<PixelFilter>("filter", &v)?),
-            _ => return Err(PyTypeError::new_err(format!("{caller}() got an unexpected keyword argument '{key}' (valid: {})", NAMES.join(", ")))),
+        if key == THREADS {
+            s.threads = Some(int_in(THREADS, &v, 1, 1024)? as u32);
+            continue;
         }
+        let Some(spec) = SETTINGS.iter().find(|s| s.key == key) else {
+            return Err(PyTypeError::new_err(format!("{caller}() got an unexpected keyword argument '{key}' (valid: {})", names().join(", "))));
+        };
+        let set = match spec.kind {
+            SettingKind::Integer { min, max } => s.overrides.set(spec.key, SettingValue::Integer(int_in(spec.key, &v, min, max)? as i128)),
+            SettingKind::Name(_) => s.overrides.set(spec.key, SettingValue::Name(&name_in(spec.key, &v)?)),
+        };
+        set.map_err(|e| PyValueError::new_err(format!("{key}: {e}")))?;
     }
     Ok(s)
 }
 
 /// `later` on top of `earlier`: the values `later` sets win.
 pub fn merge(earlier: &Overrides, later: &Overrides) -> Overrides {
-    Overrides {
-        width: later.width.or(earlier.width),
-        height: later.height.or(earlier.height),
-        spp: later.spp.or(earlier.spp),
-        max_depth: later.max_depth.or(earlier.max_depth),
-        sampler: later.sampler.or(earlier.sampler),
-        integrator: later.integrator.or(earlier.integrator),
-        light_sampling: later.light_sampling.or(earlier.light_sampling),
-        light_cells: later.light_cells.or(earlier.light_cells),
-        mis_heuristic: later.mis_heuristic.or(earlier.mis_heuristic),
-        accel: later.accel.or(earlier.accel),
-        seed: later.seed.or(earlier.seed),
-        filter: later.filter.or(earlier.filter),
-        build: later.build.clone().or_else(|| earlier.build.clone()),
-        lenient: later.lenient || earlier.lenient,
-    }
+    later.or(earlier)
 }
 
 /// A thread pool of the requested size, or `None` for rayon's global pool (all cores).

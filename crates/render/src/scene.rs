@@ -2,12 +2,9 @@ use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Primitive
 use raylab_core::{offset_ray_origin, Ray, Rgb, Vec3};
 
 use crate::camera::Camera;
-use crate::filter::PixelFilter;
-use crate::integrator::kind::IntegratorKind;
-use crate::integrator::mis::MisHeuristic;
-use crate::light::{AreaLights, EnvironmentLight, Light, LightSampling};
+use crate::light::{AreaLights, EnvironmentLight, Light};
 use crate::material::{Material, MaterialId, TextureId};
-use crate::sampler::SamplerKind;
+use crate::settings::RenderSettings;
 use crate::shading::ShadingPerturbation;
 use crate::shape::{Geometry, SurfaceGeometry};
 use crate::texture::{equirect_uv, Texture};
@@ -18,35 +15,6 @@ pub enum Background {
     Color(Rgb),
     /// An equirectangular texture looked up by ray direction.
     Texture(TextureId),
-}
-
-/// How to render: the `[render]` table of a scene, overridable from the command line.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RenderSettings {
-    pub width: u32,
-    pub height: u32,
-    /// Samples per pixel; a square number for the jittered sampler.
-    pub spp: u32,
-    pub sampler: SamplerKind,
-    /// Maximum number of path segments from the camera (1 = only what the camera sees).
-    pub max_depth: u32,
-    pub integrator: IntegratorKind,
-    /// How `direct` and `path` sample area lights.
-    pub light_sampling: LightSampling,
-    /// How `mis` weighs light and BSDF samples.
-    pub mis_heuristic: MisHeuristic,
-    /// Cells per side of the `cells` strategy's grid (read by [`Scene::build_accel`]).
-    pub light_cells: u32,
-    pub accel: AccelKind,
-    pub seed: u64,
-    /// Pixel reconstruction filter.
-    pub filter: PixelFilter,
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        Self { width: 640, height: 480, spp: 4, sampler: SamplerKind::Jittered, max_depth: 8, integrator: IntegratorKind::Whitted, light_sampling: LightSampling::Mis, mis_heuristic: MisHeuristic::Power, light_cells: crate::light::DEFAULT_CELLS, accel: AccelKind::Bvh8, seed: 0, filter: PixelFilter::Box }
-    }
 }
 
 /// A hit with everything shading needs.

@@ -173,6 +173,10 @@ fn report(name: String, scene: &Scene) -> Report {
 fn describe_light(l: &Light) -> String {
     match l {
         Light::Point { position: p, intensity: i } => format!("point at [{}, {}, {}], intensity [{}, {}, {}] W/sr", p.x, p.y, p.z, i.x, i.y, i.z),
+        Light::Spot { position: p, direction: d, intensity: i, cos_inner, cos_outer } => format!(
+            "spot at [{}, {}, {}] along [{:.3}, {:.3}, {:.3}], cones {:.1}° and {:.1}°, intensity [{}, {}, {}] W/sr",
+            p.x, p.y, p.z, d.x, d.y, d.z, cos_inner.acos().to_degrees(), cos_outer.acos().to_degrees(), i.x, i.y, i.z
+        ),
         Light::Directional { direction: d, irradiance: e } => format!("directional along [{:.3}, {:.3}, {:.3}], irradiance [{}, {}, {}]", d.x, d.y, d.z, e.x, e.y, e.z),
         Light::Ambient { intensity: i } => format!("ambient [{}, {}, {}]", i.x, i.y, i.z),
         Light::Grid { corner: c, n, intensity: i, .. } => format!("grid of {n}×{n} jittered point lights from [{}, {}, {}], total intensity [{}, {}, {}] W/sr", c.x, c.y, c.z, i.x, i.y, i.z),

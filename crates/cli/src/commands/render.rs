@@ -13,7 +13,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use raylab_accel::{Accel, Primitives};
 use raylab_render::film::atomic::{check_writable, write_atomic};
-use raylab_render::film::image_out as image_io;
+use raylab_render::film::image_out::{self as image_io, Aov, AovImage};
 use raylab_render::film::{Crop, Film, DEFAULT_PASS_SAMPLES};
 use raylab_render::render::{film_header, memory_film_header, render_tile, Control, Stop};
 
@@ -30,6 +30,11 @@ pub struct RenderArgs {
     pub output: Option<PathBuf>,
     #[command(flatten)]
     pub image: ImageArgs,
+    /// AOVs written as layers of one multi-layer -o FILE.exr beside the image, as Cycles and
+    /// Mitsuba write them (albedo.RGB, normal.XYZ facing the camera, depth.Z in scene units,
+    /// variance.Y of the pixel's luminance estimate), e.g. --aovs albedo,normal,depth,variance
+    #[arg(long, value_enum, value_delimiter = ',', value_name = "AOV,...")]
+    pub aovs: Vec<Aov>,
     /// No progress bar or summary
     #[arg(short, long)]
     pub quiet: bool,
@@ -127,6 +132,41 @@ fn parse_samples(s: &str) -> Result<(u32, u32), String> {
     Ok((a, b))
 }
 
+/// `--aovs` needs one whole image in an EXR, and each AOV once.
+fn check_aovs(aovs: &[Aov], out: &Path, partial: bool) -> Result<()> {
+    if aovs.is_empty() {
+        return Ok(());
+    }
+    if !out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
+        bail!("{}: --aovs writes one multi-layer OpenEXR file: give -o FILE.exr", out.display());
+    }
+    if partial {
+        bail!("--aovs: AOVs are written with the whole image, not with --tile, --crop or --samples");
+    }
+    if let Some(a) = aovs.iter().enumerate().find_map(|(i, a)| aovs[..i].contains(a).then_some(a)) {
+        bail!("--aovs: `{a}` is given twice");
+    }
+    Ok(())
+}
+
+/// Each AOV's image: its integrator rendered with the scene's other settings, or the
+/// beauty film's variance. The scene's integrator is back afterwards.
+fn render_aovs(scene: &mut raylab_render::Scene, film: &Film, aovs: &[Aov]) -> Vec<AovImage> {
+    let beauty = scene.settings.integrator;
+    let images = aovs
+        .iter()
+        .map(|&aov| match aov.integrator() {
+            Some(k) => {
+                scene.settings.integrator = k;
+                AovImage { aov, pixels: raylab_render::render(scene, &|_| {}).pixels }
+            }
+            None => AovImage { aov, pixels: film.variance().into_iter().map(|v| raylab_core::Rgb::new(v, 0.0, 0.0)).collect() },
+        })
+        .collect();
+    scene.settings.integrator = beauty;
+    images
+}
+
 /// What `-o` asks for.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum OutputKind {
@@ -222,6 +262,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     if partial && kind != OutputKind::Film {
         bail!("{}: --tile, --crop and --samples render part of the image: give -o PART.film (join the parts with `raylab merge`)", out.display());
     }
+    check_aovs(&a.aovs, &out, partial)?;
     // Every destination is checked before the render, not after it.
     check_writable(&out).map_err(|e| anyhow!("{e}"))?;
     if let Some(c) = &a.checkpoint {
@@ -231,9 +272,13 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let pool = a.scene.pool()?;
     pool.install(|| {
         let load_start = Instant::now();
-        let scene = a.scene.load()?;
+        let mut scene = a.scene.load()?;
         let load_s = load_start.elapsed().as_secs_f64();
-        let s = &scene.settings;
+        if let Some(w) = image_io::lossy_output_warning(&out, scene.settings.integrator) {
+            eprintln!("warning: {w}");
+        }
+        // A copy: the AOVs render the scene with their own integrators.
+        let s = scene.settings.clone();
         // Fingerprints only for films that leave the process (checkpoints, parts).
         let keeps_film = a.checkpoint.is_some() || a.resume.is_some() || kind == OutputKind::Film;
         let header = if keeps_film { film_header(&scene, a.pass_spp) } else { memory_film_header(&scene, a.pass_spp) };
@@ -290,6 +335,11 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         if written {
             match kind {
                 OutputKind::Film => write_film(&out, &film)?,
+                // A render stopped by a signal skips its AOVs, to exit promptly.
+                OutputKind::Image if !a.aovs.is_empty() && stop != Stop::Cancelled => {
+                    let aovs = render_aovs(&mut scene, &film, &a.aovs);
+                    image_io::write_exr_layers(&out, crop.width(), crop.height(), &film.resolve(), a.image.exposure, &aovs)?;
+                }
                 OutputKind::Image => a.image.write(&out, crop.width(), crop.height(), &film.resolve())?,
             }
         }

@@ -1,5 +1,8 @@
-//! Options shared by the commands that load a scene. Every named option's values come from
-//! the enum's own list of names (`ALL`), so the help, the parser and the scene files agree.
+//! Options shared by the commands that load a scene: a flag per setting of the render
+//! crate's one settings table (`raylab_render::settings::SETTINGS`, checked by a test here).
+//! Named options are clap `ValueEnum`s built from each enum's one list of names, integer
+//! options take their ranges from the table, so the help, the parser, the scene files and
+//! Python agree.
 
 use std::path::PathBuf;
 
@@ -12,11 +15,15 @@ use raylab_render::filter::PixelFilter;
 use raylab_render::integrator::MisHeuristic;
 use raylab_render::{IntegratorKind, SamplerKind, Scene};
 
-/// A clap parser accepting exactly the names of a named option enum (`SamplerKind::ALL`, ...).
-macro_rules! named {
-    ($ty:ty) => {
-        clap::builder::TypedValueParser::map(clap::builder::PossibleValuesParser::new(<$ty>::ALL.iter().map(|k| k.name())), |s| s.parse::<$ty>().expect("a possible value is a valid name"))
-    };
+/// `--accel`'s help: every structure's name, from the one list.
+fn accel_help() -> String {
+    format!("Acceleration structure by name: {} (none: the brute-force oracle; default bvh8)", AccelKind::names())
+}
+
+/// A clap parser for the integer setting `key`, in the settings table's range.
+fn ranged(key: &str) -> clap::builder::RangedI64ValueParser<u32> {
+    let (min, max) = raylab_render::settings::spec(key).and_then(|s| s.range()).expect("an integer setting");
+    clap::value_parser!(u32).range(min as i64..=max as i64)
 }
 
 #[derive(Args, Clone, Debug, Default)]
@@ -26,10 +33,10 @@ pub struct SceneArgs {
     #[command(flatten)]
     pub settings: SettingsArgs,
     /// Samples per pixel (the jittered sampler rounds up to a square number, and says so)
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1048576))]
+    #[arg(long, value_parser = ranged("spp"))]
     pub spp: Option<u32>,
     /// Area-light sampling of direct and path
-    #[arg(long, value_parser = named!(LightSamplingKind))]
+    #[arg(long, value_enum)]
     pub light_sampling: Option<LightSamplingKind>,
     /// Warn about and skip what raylab does not support in a pbrt-v4 scene, instead of failing
     #[arg(long)]
@@ -41,22 +48,22 @@ pub struct SceneArgs {
 #[derive(Args, Clone, Debug, Default)]
 pub struct SettingsArgs {
     /// Image width in pixels (overrides the scene's)
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_parser = ranged("width"))]
     pub width: Option<u32>,
     /// Image height in pixels (overrides the scene's)
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_parser = ranged("height"))]
     pub height: Option<u32>,
     /// Pixel sampler (jittered: stratified; sobol: scrambled low-discrepancy)
-    #[arg(long, value_parser = named!(SamplerKind))]
+    #[arg(long, value_enum)]
     pub sampler: Option<SamplerKind>,
     /// Maximum number of path segments from the camera
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    #[arg(long, value_parser = ranged("max_depth"))]
     pub max_depth: Option<u32>,
     /// Integrator (lighting: whitted, direct, path; AOVs: normals, albedo, depth; statistics: heatmap, heatmap-tests)
-    #[arg(long, value_parser = named!(IntegratorKind))]
+    #[arg(long, value_enum)]
     pub integrator: Option<IntegratorKind>,
-    /// Acceleration structure by name: none (the brute-force oracle), bvh, kdtree, grid, sbvh, ... (an unknown name lists them all)
-    #[arg(long)]
+    /// Acceleration structure by name (`none` is the brute-force oracle)
+    #[arg(long, help = accel_help())]
     pub accel: Option<String>,
     /// Largest leaf of the acceleration structure's build (default 8)
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=255))]
@@ -65,13 +72,13 @@ pub struct SettingsArgs {
     #[arg(long, value_parser = clap::value_parser!(u32).range(2..=1024))]
     pub bins: Option<u32>,
     /// Pixel reconstruction filter
-    #[arg(long, value_parser = named!(PixelFilter))]
+    #[arg(long, value_enum)]
     pub filter: Option<PixelFilter>,
     /// MIS weights of light and BSDF samples (default power)
-    #[arg(long, value_parser = named!(MisHeuristic))]
+    #[arg(long, value_enum)]
     pub mis_heuristic: Option<MisHeuristic>,
     /// Cells per side of the `cells` light-sampling grid (1 to 16; default 8)
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16))]
+    #[arg(long, value_parser = ranged("light_cells"))]
     pub light_cells: Option<u32>,
     /// Seed of the per-pixel random streams
     #[arg(long)]
@@ -145,5 +152,40 @@ impl SceneArgs {
             eprintln!("warning: {w}");
         }
         Ok(scene)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::{Args, Command};
+    use raylab_render::settings::{SettingKind, SETTINGS};
+
+    /// The settings table drives the flags: each key has one, with the table's names or range.
+    #[test]
+    fn every_setting_has_a_flag_with_the_tables_names_and_range() {
+        let cmd = super::SceneArgs::augment_args(Command::new("render"));
+        let parses = |flag: &str, value: &str| cmd.clone().try_get_matches_from(["render", flag, value]).is_ok();
+        for spec in SETTINGS {
+            let flag = spec.flag();
+            let arg = cmd.get_arguments().find(|a| a.get_long() == Some(&flag[2..])).unwrap_or_else(|| panic!("no flag {flag} for the setting `{}`", spec.key));
+            match spec.kind {
+                // `--accel` parses by name itself, for its message listing the valid ones.
+                SettingKind::Name(names) if spec.key == "accel" => {
+                    for name in names().split(", ") {
+                        let a = super::SceneArgs { settings: super::SettingsArgs { accel: Some(name.into()), ..Default::default() }, ..Default::default() };
+                        assert_eq!(a.overrides().unwrap().accel.unwrap().name(), name);
+                    }
+                }
+                SettingKind::Name(names) => {
+                    let values: Vec<String> = arg.get_possible_values().iter().map(|p| p.get_name().to_string()).collect();
+                    assert_eq!(values.join(", "), names(), "{flag}");
+                }
+                SettingKind::Integer { min, max } => {
+                    assert!(parses(&flag, &min.to_string()) && parses(&flag, &max.to_string()), "{flag}");
+                    assert!(!parses(&flag, &(max as u128 + 1).to_string()), "{flag} accepts {}", max as u128 + 1);
+                    assert!(min == 0 || !parses(&flag, &(min - 1).to_string()), "{flag} accepts {}", min - 1);
+                }
+            }
+        }
     }
 }

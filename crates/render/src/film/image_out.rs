@@ -179,6 +179,111 @@ pub fn write_image(path: &Path, width: u32, height: u32, pixels: &[Rgb], tonemap
     write_atomic(path, &bytes).map_err(|e| err(path, format!("cannot write: {e}")))
 }
 
+/// An AOV (arbitrary output variable) written as a layer of a multi-layer EXR beside the
+/// beauty image, as Cycles and Mitsuba 3 write them: one part, the beauty as `R`, `G`, `B`
+/// and each AOV's channels prefixed with its name (`albedo.R`, `normal.X`, `depth.Z`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Aov {
+    /// The first hit's diffuse colour (linear RGB), the `albedo` integrator's.
+    Albedo,
+    /// The world-space shading normal facing the camera (Cycles' convention), in [-1, 1];
+    /// 0 where nothing is hit.
+    Normal,
+    /// The distance to the first hit along the camera ray, in scene units; 0 where nothing
+    /// is hit.
+    Depth,
+    /// The variance of the pixel's estimate of luminance (sample variance / samples).
+    Variance,
+}
+
+raylab_core::named_enum!(Aov, "AOV", { Albedo => "albedo", Normal => "normal", Depth => "depth", Variance => "variance" });
+
+impl Aov {
+    /// The integrator whose image this AOV decodes; `None` for the variance, which comes
+    /// from the beauty render's own sums.
+    pub fn integrator(self) -> Option<crate::IntegratorKind> {
+        match self {
+            Aov::Albedo => Some(crate::IntegratorKind::Albedo),
+            Aov::Normal => Some(crate::IntegratorKind::Normals),
+            Aov::Depth => Some(crate::IntegratorKind::Depth),
+            Aov::Variance => None,
+        }
+    }
+
+    /// The channel names of its layer (without the layer's name).
+    pub fn channels(self) -> &'static [&'static str] {
+        match self {
+            Aov::Albedo => &["R", "G", "B"],
+            Aov::Normal => &["X", "Y", "Z"],
+            Aov::Depth => &["Z"],
+            Aov::Variance => &["Y"],
+        }
+    }
+
+    /// The layer's values of one pixel from its integrator's colour (or the variance in `x`):
+    /// the `normals` integrator's `0.5 · (n + 1)` decoded to `n`.
+    pub fn decode(self, c: Rgb) -> [f32; 3] {
+        match self {
+            Aov::Normal => (2.0 * c - Rgb::ONE).to_array(),
+            _ => c.to_array(),
+        }
+    }
+}
+
+/// One AOV's image, row-major from the top like the beauty's: its integrator's colours as
+/// rendered (the variance in `x`).
+pub struct AovImage {
+    pub aov: Aov,
+    pub pixels: Vec<Rgb>,
+}
+
+/// Encodes the beauty image (exposed like a plain EXR) and its AOVs (as they are) as one
+/// single-part EXR with a layer per AOV; channel names sort within the part as the format
+/// requires.
+pub fn encode_exr_layers(path: &Path, width: u32, height: u32, beauty: &[Rgb], exposure: f32, aovs: &[AovImage]) -> Result<Vec<u8>, ImageError> {
+    use exr::prelude::*;
+    check_size(path, width, height, beauty)?;
+    check_exposure(exposure).map_err(|m| err(path, m))?;
+    let scale = exposure.exp2();
+    let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        channels.push(AnyChannel::new(*name, FlatSamples::F32(beauty.iter().map(|p| exposed(p[c], scale)).collect())));
+    }
+    for a in aovs {
+        check_size(path, width, height, &a.pixels)?;
+        if channels.iter().any(|ch| ch.name.to_string().starts_with(&format!("{}.", a.aov.name()))) {
+            return Err(err(path, format!("the AOV `{}` is given twice", a.aov)));
+        }
+        for (c, name) in a.aov.channels().iter().enumerate() {
+            let values = a.pixels.iter().map(|p| { let v = a.aov.decode(*p)[c]; if v.is_finite() { v } else { 0.0 } }).collect();
+            channels.push(AnyChannel::new(format!("{}.{name}", a.aov.name()).as_str(), FlatSamples::F32(values)));
+        }
+    }
+    let layer = Layer::new((width as usize, height as usize), LayerAttributes::default(), Encoding::SMALL_LOSSLESS, AnyChannels::sort(channels.into()));
+    let mut out = std::io::Cursor::new(Vec::new());
+    // Sequential, for the same bytes every time (see `encode_image`).
+    Image::from_layer(layer).write().non_parallel().to_buffered(&mut out).map_err(|e| err(path, format!("cannot encode OpenEXR: {e}")))?;
+    Ok(out.into_inner())
+}
+
+/// Writes [`encode_exr_layers`]'s file atomically.
+pub fn write_exr_layers(path: &Path, width: u32, height: u32, beauty: &[Rgb], exposure: f32, aovs: &[AovImage]) -> Result<(), ImageError> {
+    if extension(path) != "exr" {
+        return Err(err(path, "AOVs go into one multi-layer OpenEXR file: give an .exr output"));
+    }
+    let bytes = encode_exr_layers(path, width, height, beauty, exposure, aovs)?;
+    write_atomic(path, &bytes).map_err(|e| err(path, format!("cannot write: {e}")))
+}
+
+/// Why writing `integrator`'s image to `path` loses its values, if it does: depth is a
+/// distance in scene units, which an 8-bit format clips at 1 (white beyond one unit).
+pub fn lossy_output_warning(path: &Path, integrator: crate::IntegratorKind) -> Option<String> {
+    let eight_bit = matches!(extension(path).as_str(), "png" | "ppm");
+    (eight_bit && integrator == crate::IntegratorKind::Depth).then(|| {
+        format!("{}: depth is a distance in scene units, and an 8-bit image clips it at 1 (everything farther than one unit is white): write .exr or .pfm for the distances, or scale them with --exposure -N (2^-N)", path.display())
+    })
+}
+
 /// Writes 8-bit PNG values `round(255 · v)` with no tone map and no sRGB curve: for data
 /// such as normal maps, read back with `srgb = false`.
 pub fn write_linear_png(path: &Path, width: u32, height: u32, pixels: &[Rgb]) -> Result<(), ImageError> {
@@ -247,5 +352,78 @@ mod tests {
         assert_eq!(Tonemap::Clamp.apply(0.25, 1.0), 0.5);
         assert_eq!(Tonemap::Reinhard.apply(1.0, 0.0), 0.5);
         assert_eq!("gamma".parse::<Tonemap>().unwrap_err().to_string(), "unknown tone map `gamma` (valid: clamp, reinhard, aces)");
+    }
+
+    /// The channels of a multi-layer EXR, read back with the exr crate: name -> values.
+    fn read_channels(bytes: &[u8]) -> std::collections::BTreeMap<String, Vec<f32>> {
+        use exr::prelude::*;
+        let image = read().no_deep_data().largest_resolution_level().all_channels().first_valid_layer().all_attributes().from_buffered(std::io::Cursor::new(bytes)).unwrap();
+        image.layer_data.channel_data.list.iter().map(|c| (c.name.to_string(), c.sample_data.values_as_f32().collect())).collect()
+    }
+
+    #[test]
+    fn a_layer_per_aov_beside_the_beauty() {
+        let beauty = [Rgb::new(1.0, 2.0, 3.0), Rgb::ZERO];
+        let aovs = [
+            AovImage { aov: Aov::Normal, pixels: vec![Rgb::new(0.5, 1.0, 0.5), Rgb::splat(0.5)] },
+            AovImage { aov: Aov::Variance, pixels: vec![Rgb::new(0.25, 0.0, 0.0), Rgb::ZERO] },
+        ];
+        let c = read_channels(&encode_exr_layers(Path::new("t.exr"), 2, 1, &beauty, 1.0, &aovs).unwrap());
+        let names: Vec<&str> = c.keys().map(String::as_str).collect();
+        assert_eq!(names, ["B", "G", "R", "normal.X", "normal.Y", "normal.Z", "variance.Y"]);
+        // The beauty is exposed (one stop: ×2), the AOVs are not; normals decode to [-1, 1].
+        assert_eq!((c["R"][0], c["G"][0], c["B"][0]), (2.0, 4.0, 6.0));
+        assert_eq!((c["normal.X"].clone(), c["normal.Y"].clone(), c["normal.Z"].clone()), (vec![0.0, 0.0], vec![1.0, 0.0], vec![0.0, 0.0]));
+        assert_eq!(c["variance.Y"], [0.25, 0.0]);
+        let twice = [AovImage { aov: Aov::Depth, pixels: vec![Rgb::ONE; 2] }, AovImage { aov: Aov::Depth, pixels: vec![Rgb::ONE; 2] }];
+        assert_eq!(encode_exr_layers(Path::new("t.exr"), 2, 1, &beauty, 0.0, &twice).unwrap_err().to_string(), "t.exr: the AOV `depth` is given twice");
+        assert_eq!(write_exr_layers(Path::new("t.png"), 2, 1, &beauty, 0.0, &[]).unwrap_err().to_string(), "t.png: AOVs go into one multi-layer OpenEXR file: give an .exr output");
+        assert_eq!("normals".parse::<Aov>().unwrap_err(), "unknown AOV `normals` (valid: albedo, normal, depth, variance)");
+    }
+
+    /// A diffuse square of albedo (0.2, 0.4, 0.6) in the plane z = 0 filling the middle of a
+    /// 9×9 image, seen from z = 3 along -z: every AOV has a closed form at the centre pixel
+    /// (its samples stay within a pixel's half-diagonal, atan(√2 · tan(10°) / 9) = 1.59°, of
+    /// the axis, so depth is in [3, 3 / cos 1.59°] = [3, 3.00116]) and at the corners, which miss.
+    #[test]
+    fn aov_layers_of_a_plane_at_a_known_distance() {
+        use crate::{render, Camera, IntegratorKind, Material, RenderSettings, Scene, TexColor, TriangleMesh};
+        use raylab_core::Vec3;
+        for facing in [1.0f32, -1.0] {
+            let camera = Camera::new(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y, 20.0, 1.0, 0.0, None).unwrap();
+            let mut scene = Scene::new(camera, RenderSettings { width: 9, height: 9, spp: 4, ..Default::default() });
+            let m = scene.add_material("m", Material::Diffuse { albedo: TexColor::Constant(Rgb::new(0.2, 0.4, 0.6)) });
+            // Wound to face the camera, then away from it (a floor seen from below its winding):
+            // the normal layer faces the camera either way.
+            let corners = [Vec3::new(-0.3, -0.3, 0.0), Vec3::new(0.3, -0.3, 0.0), Vec3::new(0.3, 0.3, 0.0), Vec3::new(-0.3, 0.3, 0.0)];
+            let indices = if facing > 0.0 { vec![[0, 1, 2], [0, 2, 3]] } else { vec![[0, 2, 1], [0, 3, 2]] };
+            scene.geometry.add_mesh(TriangleMesh { positions: corners.to_vec(), indices, material: m, ..Default::default() });
+            scene.build_accel(&raylab_accel::BuildOptions::default());
+            let aovs: Vec<AovImage> = [Aov::Albedo, Aov::Normal, Aov::Depth]
+                .into_iter()
+                .map(|aov| {
+                    scene.settings.integrator = aov.integrator().unwrap();
+                    AovImage { aov, pixels: render(&scene, &|_| {}).pixels }
+                })
+                .collect();
+            scene.settings.integrator = IntegratorKind::Albedo;
+            let beauty = render(&scene, &|_| {}).pixels;
+            let c = read_channels(&encode_exr_layers(Path::new("t.exr"), 9, 9, &beauty, 0.0, &aovs).unwrap());
+            let (centre, corner) = (4 * 9 + 4, 0);
+            assert_eq!([c["albedo.R"][centre], c["albedo.G"][centre], c["albedo.B"][centre]], [0.2, 0.4, 0.6]);
+            let n = Vec3::new(c["normal.X"][centre], c["normal.Y"][centre], c["normal.Z"][centre]);
+            assert!((n - Vec3::Z).length() < 1e-6, "facing {facing}: normal {n}");
+            assert!((3.0..=3.00116).contains(&c["depth.Z"][centre]), "depth {}", c["depth.Z"][centre]);
+            assert_eq!([c["normal.X"][corner], c["normal.Y"][corner], c["normal.Z"][corner], c["depth.Z"][corner], c["albedo.R"][corner]], [0.0; 5]);
+            assert_eq!(c["R"][centre], 0.2);
+        }
+    }
+
+    #[test]
+    fn depth_to_an_eight_bit_image_is_warned_about() {
+        use crate::IntegratorKind;
+        assert!(lossy_output_warning(Path::new("d.png"), IntegratorKind::Depth).unwrap().starts_with("d.png: depth is a distance in scene units, and an 8-bit image clips it at 1"));
+        assert_eq!(lossy_output_warning(Path::new("d.exr"), IntegratorKind::Depth), None);
+        assert_eq!(lossy_output_warning(Path::new("d.png"), IntegratorKind::Albedo), None);
     }
 }

@@ -10,7 +10,8 @@ pub enum IntegratorKind {
     Direct,
     /// Path tracing: next-event estimation, MIS, Russian roulette.
     Path,
-    /// Shading normals as colours (`0.5 · (n + 1)`), for checking geometry.
+    /// World-space shading normals facing the camera, as colours (`0.5 · (n + 1)`; grey
+    /// where nothing is hit), for checking geometry.
     Normals,
     /// The first hit's diffuse colour (an AOV for denoisers and checks).
     Albedo,

@@ -27,9 +27,12 @@ impl IntegratorKind {
                 None => Rgb::ZERO,
             },
             IntegratorKind::Depth => scene.intersect(ray, counters).map_or(Rgb::ZERO, |h| Rgb::splat(h.t * ray.dir.length())),
+            // Facing the camera, as Cycles' Normal pass (a floor seen from above looks up
+            // whichever way its triangles wind); where nothing is hit, the zero normal (grey),
+            // so that `2c - 1` decodes every pixel, edges included, to the mean normal.
             IntegratorKind::Normals => match scene.intersect(ray, counters) {
-                Some(h) => 0.5 * (h.geom.ns + Rgb::ONE),
-                None => Rgb::ZERO,
+                Some(h) => 0.5 * (if h.geom.ng.dot(ray.dir) > 0.0 { -h.geom.ns } else { h.geom.ns } + Rgb::ONE),
+                None => Rgb::splat(0.5),
             },
             IntegratorKind::Heatmap => heatmap::cost(scene, ray, heatmap::HeatMetric::NodesVisited, counters),
             IntegratorKind::HeatmapTests => heatmap::cost(scene, ray, heatmap::HeatMetric::PrimTests, counters),

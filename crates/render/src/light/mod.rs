@@ -25,6 +25,11 @@ pub enum Light {
     /// parallelogram `corner + s·edge_u + t·edge_v`, each jittered inside its cell and
     /// carrying `intensity / n²` (so the total stays that of one point light).
     Grid { corner: Vec3, edge_u: Vec3, edge_v: Vec3, n: u32, intensity: Rgb },
+    /// A point light shining into a cone along unit `direction` (glTF's
+    /// `KHR_lights_punctual` spot): full `intensity` within `cos_inner` of the axis, none
+    /// beyond `cos_outer`, and between them the extension's falloff, the square of a linear
+    /// ramp in the cosine.
+    Spot { position: Vec3, direction: Vec3, intensity: Rgb, cos_inner: f32, cos_outer: f32 },
 }
 
 /// Light arriving at a point from one light.
@@ -45,6 +50,7 @@ impl Light {
             Light::Directional { .. } => "directional",
             Light::Ambient { .. } => "ambient",
             Light::Grid { .. } => "grid",
+            Light::Spot { .. } => "spot",
         }
     }
 
@@ -73,8 +79,20 @@ impl Light {
             }
             Light::Directional { direction, irradiance } => Some(LightSample { wi: -direction, dist: f32::INFINITY, irradiance }),
             Light::Ambient { .. } => None,
+            Light::Spot { position, direction, intensity, cos_inner, cos_outer } => {
+                let s = point(p, position, intensity)?;
+                let falloff = spot_falloff(direction.dot(-s.wi), cos_inner, cos_outer);
+                (falloff > 0.0).then(|| LightSample { irradiance: s.irradiance * falloff, ..s })
+            }
         }
     }
+}
+
+/// `KHR_lights_punctual`'s spot attenuation at angle cosine `cos` from the axis:
+/// `clamp((cos - cos_outer) / max(1e-3, cos_inner - cos_outer), 0, 1)²`.
+pub fn spot_falloff(cos: f32, cos_inner: f32, cos_outer: f32) -> f32 {
+    let t = ((cos - cos_outer) / (cos_inner - cos_outer).max(1e-3)).clamp(0.0, 1.0);
+    t * t
 }
 
 fn point(p: Vec3, position: Vec3, intensity: Rgb) -> Option<LightSample> {
@@ -90,6 +108,21 @@ fn point(p: Vec3, position: Vec3, intensity: Rgb) -> Option<LightSample> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn spot_light_is_a_point_light_inside_its_cone() {
+        // Axis straight down from (0, 2, 0); inner cone 30°, outer 60°.
+        let (ci, co) = (30f32.to_radians().cos(), 60f32.to_radians().cos());
+        let l = Light::Spot { position: Vec3::new(0.0, 2.0, 0.0), direction: -Vec3::Y, intensity: Rgb::splat(8.0), cos_inner: ci, cos_outer: co };
+        assert_eq!(l.sample(Vec3::ZERO, 0, Vec2::ZERO).unwrap().irradiance, Rgb::splat(2.0));
+        // 45° off the axis (distance² 8): halfway in cosine between the cones' gives the ramp's
+        // value ((cos 45° - cos 60°) / (cos 30° - cos 60°))².
+        let s = l.sample(Vec3::new(2.0, 0.0, 0.0), 0, Vec2::ZERO).unwrap();
+        let t = (45f32.to_radians().cos() - co) / (ci - co);
+        assert!((s.irradiance.x - 1.0 * t * t).abs() < 1e-6, "{}", s.irradiance);
+        // Beyond the outer cone: no light.
+        assert!(l.sample(Vec3::new(4.0, 1.0, 0.0), 0, Vec2::ZERO).is_none());
+    }
 
     #[test]
     fn point_light_falls_off_with_the_square_of_distance() {
