@@ -5,9 +5,12 @@ pub mod bench;
 pub mod compare;
 pub mod bake;
 pub mod converge;
+pub mod heatmap;
+pub mod merge;
 pub mod rayfile;
 pub mod report;
 pub mod rays;
+pub mod sweep;
 pub mod trace;
 
 pub use rays::{RayKind, RaySet};

@@ -10,13 +10,6 @@ use plotters::prelude::*;
 
 use crate::bench::{BenchReport, BenchResult};
 
-/// A heat-map thumbnail to show beside a scene's table.
-pub struct Thumbnail {
-    pub scene: String,
-    pub accel: String,
-    pub png: Vec<u8>,
-}
-
 const PALETTE: [RGBColor; 10] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
@@ -137,8 +130,43 @@ pub(crate) const STYLE: &str = "body{font-family:sans-serif;max-width:1200px;mar
     td,th{border:1px solid #ccc;padding:3px 8px;text-align:right} th{background:#f2f2f2} td:first-child{text-align:left}\
     .charts{display:flex;flex-wrap:wrap;gap:8px} .thumbs img{width:240px;margin:4px;image-rendering:pixelated} figure{display:inline-block;margin:4px}";
 
+/// The heat maps of one scene's structures, drawn on one shared scale (the most nodes any
+/// structure's ray visited) with its legend.
+fn heatmaps(report: &BenchReport, scene: &str) -> String {
+    let maps: Vec<(&str, u32, u32, Vec<u32>)> = report.heatmaps.iter().filter(|m| m.scene == scene).filter_map(|m| Some((m.accel.as_str(), m.width, m.height, crate::heatmap::unpack(&m.nodes)?))).collect();
+    let Some(max) = maps.iter().flat_map(|m| m.3.iter().copied()).max() else { return String::new() };
+    let mut h = format!("<h3>Nodes visited per camera ray</h3><p>One colour scale for every structure of this scene: 0 to {max} nodes.</p>{}<div class=\"thumbs\">", legend(max));
+    for (accel, w, hgt, counts) in &maps {
+        let png = crate::heatmap::to_png(*w, *hgt, counts, max);
+        let _ = write!(h, "<figure><img alt=\"{a}\" src=\"data:image/png;base64,{}\"><figcaption>{a}</figcaption></figure>", base64(&png), a = esc(accel));
+    }
+    h.push_str("</div>");
+    h
+}
+
+/// The heat maps' colour ramp as an SVG bar labelled from 0 to `max` nodes.
+fn legend(max: u32) -> String {
+    const STEPS: usize = 32;
+    let mut stops = String::new();
+    for i in 0..=STEPS {
+        let x = i as f32 / STEPS as f32;
+        let c = crate::heatmap::display_rgb(x);
+        let _ = write!(stops, "<stop offset=\"{:.3}\" stop-color=\"rgb({},{},{})\"/>", x, c[0], c[1], c[2]);
+    }
+    let ticks: String = (0..=4)
+        .map(|i| {
+            let x = 10.0 + 400.0 * i as f64 / 4.0;
+            format!("<line x1=\"{x}\" y1=\"30\" x2=\"{x}\" y2=\"36\" stroke=\"black\"/><text x=\"{x}\" y=\"50\" text-anchor=\"middle\" font-size=\"12\">{}</text>", (max as f64 * i as f64 / 4.0).round())
+        })
+        .collect();
+    format!(
+        "<svg class=\"heat-legend\" width=\"520\" height=\"56\" xmlns=\"http://www.w3.org/2000/svg\"><defs><linearGradient id=\"heat-ramp\">{stops}</linearGradient></defs>\
+         <rect x=\"10\" y=\"8\" width=\"400\" height=\"22\" fill=\"url(#heat-ramp)\" stroke=\"black\"/>{ticks}<text x=\"420\" y=\"24\" font-size=\"12\">nodes per ray</text></svg>"
+    )
+}
+
 /// The whole report as one HTML page.
-pub fn html(report: &BenchReport, thumbnails: &[Thumbnail]) -> String {
+pub fn html(report: &BenchReport) -> String {
     let mut h = String::new();
     let _ = write!(
         h,
@@ -190,14 +218,7 @@ pub fn html(report: &BenchReport, thumbnails: &[Thumbnail]) -> String {
             h.push_str(&bar_chart(&format!("{k} rays: primitive tests per ray"), "tests / ray", &rows.iter().map(|r| (r.accel.clone(), r.rays[k].prim_tests_per_ray)).collect::<Vec<_>>()));
         }
         h.push_str("</div>");
-        let thumbs: Vec<&Thumbnail> = thumbnails.iter().filter(|t| t.scene == *scene).collect();
-        if !thumbs.is_empty() {
-            h.push_str("<h3>Nodes visited per camera ray</h3><div class=\"thumbs\">");
-            for t in thumbs {
-                let _ = write!(h, "<figure><img alt=\"{a}\" src=\"data:image/png;base64,{}\"><figcaption>{a}</figcaption></figure>", base64(&t.png), a = esc(&t.accel));
-            }
-            h.push_str("</div>");
-        }
+        h.push_str(&heatmaps(report, scene));
     }
     if scenes.len() >= 2 {
         let mut build: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
