@@ -14,7 +14,7 @@ use raylab_core::Rgb;
 use raylab_lab::bench::BenchReport;
 use raylab_lab::sweep::{self, BenchSettings, LabError, Progress};
 use raylab_lab::compare::{compare as compare_images, ImageDiff};
-use raylab_lab::converge::{spp_slope, strategies as strategy_names, ConvergencePoint};
+use raylab_lab::converge::{measure, render_with, spp_slope, strategies as strategy_names, Study, REFERENCE_SEED_XOR};
 use raylab_lab::RayKind;
 use raylab_loader::image_io::read_image;
 use raylab_loader::Overrides;
@@ -214,12 +214,6 @@ pub fn converge<'py>(
                 st.sampler.check_spp(n).map_err(|e| JobError::Other(format!("spp: {e}")))?;
             }
             let (w, h) = (st.width, st.height);
-            let mut render_with = |strategy: LightSampling, spp: u32, seed: u64| {
-                scene.settings.light_sampling = strategy;
-                scene.settings.spp = spp;
-                scene.settings.seed = seed;
-                raylab_render::render(&scene, &|_| {})
-            };
             let ref_pixels = match reference {
                 Some((rw, rh, px)) => {
                     if (rw, rh) != (w, h) {
@@ -229,22 +223,12 @@ pub fn converge<'py>(
                 }
                 None => {
                     st.sampler.check_spp(reference_spp).map_err(|e| JobError::Other(format!("reference_spp: {e}")))?;
-                    // Another seed, as in the CLI: a reference sharing the renders' random
-                    // streams would correlate with them and understate their error.
-                    render_with(LightSampling::Mis, reference_spp, st.seed ^ 0x9e37_79b9_7f4a_7c15).pixels
+                    render_with(&mut scene, LightSampling::Mis, reference_spp, st.seed ^ REFERENCE_SEED_XOR).pixels
                 }
             };
-            let mut points = Vec::new();
-            for &strategy in &strategy_list {
-                for &n in &spps {
-                    if cancel.is_set() {
-                        return Err(JobError::Other("interrupted".into()));
-                    }
-                    let out = render_with(strategy, n, st.seed);
-                    let d = compare_images(&out.pixels, &ref_pixels, w, exclude_bright).map_err(|e| JobError::Other(format!("{strategy} at {n} spp: {e}")))?;
-                    points.push(ConvergencePoint { strategy: strategy.name().into(), spp: n, seconds: out.seconds, mse: d.mse, rmse: d.rmse, rel_mse: d.rel_mse });
-                }
-            }
+            scene.settings.seed = st.seed;
+            let study = Study { strategies: &strategy_list, spps: &spps, time_budget: None, exclude_bright };
+            let (points, _) = measure(&mut scene, &ref_pixels, &study, &mut |_| {}, &|| cancel.is_set()).map_err(JobError::Other)?;
             Ok((w, h, points, ref_pixels))
         })
     })??;
