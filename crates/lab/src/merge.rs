@@ -59,7 +59,7 @@ pub fn merge(parts: &[Part]) -> Result<BenchReport, String> {
     }
     // Rows in job-list order; a structure whose ray sets were split between parts gets one row
     // (build figures from the first part that built it).
-    let scene_order = |name: &str| (0..settings.scenes.len().max(1)).position(|i| settings.scene_name(i) == name).unwrap_or(usize::MAX);
+    let scene_order = |name: &str| (0..settings.scenes.len()).position(|i| settings.scene_name(i) == name).unwrap_or(usize::MAX);
     let accel_order = |name: &str| settings.accels.iter().position(|a| a == name).unwrap_or(usize::MAX);
     let mut rows: BTreeMap<(usize, usize), BenchResult> = BTreeMap::new();
     for p in parts {

@@ -95,7 +95,7 @@ pub fn jobs(settings: &BenchSettings) -> Result<Vec<Job>, LabError> {
     let accels = parse_list::<AccelKind>("accels", &settings.accels.join(","))?;
     let kinds = parse_list::<RayKind>("rays", &settings.rays.join(","))?;
     let mut out = Vec::new();
-    for scene in 0..settings.scenes.len().max(1) {
+    for scene in 0..settings.scenes.len() {
         for &accel in &accels {
             for &rays in &kinds {
                 out.push(Job { index: out.len(), scene, accel, rays });
@@ -345,4 +345,43 @@ fn run_scene(settings: &BenchSettings, scene_index: usize, jobs: &[Job], dump_ra
     progress.scene_done(&SceneSummary { name, primitives: prims.len(), grid: (settings.resolution, height), oracle: oracle_kind.name().into(), repeats: settings.repeats }, &results);
     report.results.extend(results);
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jobs_are_scene_major_then_structure_then_ray_set() {
+        let mut s = BenchSettings::new(vec![Some("a.toml".into()), None], "bvh,kdtree").unwrap();
+        s.rays = vec!["primary".into(), "shadow".into()];
+        let j = jobs(&s).unwrap();
+        assert_eq!(j.len(), 8);
+        assert_eq!((j[0].scene, j[0].accel, j[0].rays), (0, AccelKind::Bvh, RayKind::Primary));
+        assert_eq!((j[3].scene, j[3].accel, j[3].rays), (0, AccelKind::KdTree, RayKind::Shadow));
+        assert_eq!((j[4].scene, j[4].accel, j[4].rays), (1, AccelKind::Bvh, RayKind::Primary));
+        assert_eq!(j[5].describe(&s), "job 5 (default scene, bvh, shadow rays)");
+        assert!(jobs(&BenchSettings::new(vec![], "all").unwrap()).unwrap().is_empty());
+    }
+
+    #[test]
+    fn shards_cover_the_list_exactly_once_in_near_equal_blocks() {
+        for n in [0, 1, 5, 9, 42] {
+            for count in 1..=12 {
+                let ranges: Vec<_> = (1..=count).map(|index| Shard { index, count }.range(n)).collect();
+                assert_eq!(ranges[0].start, 0);
+                assert_eq!(ranges[count as usize - 1].end, n);
+                for w in ranges.windows(2) {
+                    assert_eq!(w[0].end, w[1].start);
+                }
+                let sizes: Vec<usize> = ranges.iter().map(|r| r.len()).collect();
+                assert!(sizes.iter().max().unwrap() - sizes.iter().min().unwrap() <= 1, "{n} jobs in {count}: {sizes:?}");
+            }
+        }
+        assert_eq!(Shard { index: 2, count: 3 }.range(9), 3..6);
+        assert_eq!("2/3".parse::<Shard>(), Ok(Shard { index: 2, count: 3 }));
+        for bad in ["0/3", "4/3", "1/0", "3", "a/b"] {
+            assert_eq!(bad.parse::<Shard>(), Err(format!("expected I/N with 1 <= I <= N (e.g. 2/8), found `{bad}`")));
+        }
+    }
 }

@@ -123,7 +123,11 @@ fn measure(a: &BenchArgs) -> Result<BenchReport> {
     let jobs = match a.shard {
         Some(s) => {
             let r = s.range(all.len());
-            eprintln!("shard {s}: jobs {} to {} of {}", r.start, r.end.saturating_sub(1), all.len());
+            if r.is_empty() {
+                eprintln!("shard {s}: no jobs (the list has {} jobs)", all.len());
+            } else {
+                eprintln!("shard {s}: jobs {} to {} of {}", r.start, r.end - 1, all.len());
+            }
             all[r].to_vec()
         }
         None => all,
