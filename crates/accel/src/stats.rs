@@ -1,7 +1,7 @@
 use std::fmt;
 
 /// A structure's report after build (after Embree's `bvh_statistics` and pbrt's stats).
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AccelStats {
     pub name: String,
     pub build_ms: f64,

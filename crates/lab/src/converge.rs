@@ -1,11 +1,78 @@
 //! Convergence studies: the error of renders against a reference as the sample count grows,
-//! per light-sampling strategy — the third seed report's MSE-against-samples study. The
-//! rendering is the caller's; this module fits slopes and writes the CSV and the HTML page.
+//! per light-sampling strategy — the third seed report's MSE-against-samples study. This
+//! module renders the series ([`measure`], shared by `raylab converge` and Python), fits
+//! slopes and writes the CSV and the HTML page; the callers parse options and write files.
 
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
+use raylab_core::Rgb;
+use raylab_render::light::LightSampling;
+use raylab_render::Scene;
+
 use crate::report::{base64, esc, loglog_chart, STYLE};
+
+/// The seed of a rendered reference is the renders' seed with these bits flipped: a reference
+/// sharing the renders' random streams would correlate with them and understate their error.
+pub const REFERENCE_SEED_XOR: u64 = 0x9e37_79b9_7f4a_7c15;
+
+/// Renders `scene` with `strategy` at `spp` and `seed`; none of them needs the acceleration
+/// structure rebuilt.
+pub fn render_with(scene: &mut Scene, strategy: LightSampling, spp: u32, seed: u64) -> raylab_render::RenderOutput {
+    scene.settings.light_sampling = strategy;
+    scene.settings.spp = spp;
+    scene.settings.seed = seed;
+    raylab_render::render(scene, &|_| {})
+}
+
+/// What a study renders: each strategy at each sample count, in increasing order.
+pub struct Study<'a> {
+    pub strategies: &'a [LightSampling],
+    pub spps: &'a [u32],
+    /// A strategy's series stops after its first render over this many seconds (that render
+    /// is still measured).
+    pub time_budget: Option<f64>,
+    /// Pixels whose reference luminance exceeds this are left out of the errors.
+    pub exclude_bright: Option<f32>,
+}
+
+/// A strategy's last render of a study.
+pub struct FinalImage {
+    pub strategy: LightSampling,
+    pub spp: u32,
+    pub pixels: Vec<Rgb>,
+}
+
+/// Renders the study of `scene` (at its own seed) and measures each render against
+/// `reference`. `on_point` sees each point as it is measured; `cancelled` is asked before each
+/// render and stops the study with the error `interrupted`.
+pub fn measure(scene: &mut Scene, reference: &[Rgb], study: &Study, on_point: &mut dyn FnMut(&ConvergencePoint), cancelled: &dyn Fn() -> bool) -> Result<(Vec<ConvergencePoint>, Vec<FinalImage>), String> {
+    let (width, seed) = (scene.settings.width, scene.settings.seed);
+    let mut points = Vec::new();
+    let mut finals = Vec::new();
+    for &strategy in study.strategies {
+        let mut last = None;
+        for &spp in study.spps {
+            if cancelled() {
+                return Err("interrupted".into());
+            }
+            let out = render_with(scene, strategy, spp, seed);
+            let d = crate::compare::compare(&out.pixels, reference, width, study.exclude_bright).map_err(|e| format!("{strategy} at {spp} spp: {e}"))?;
+            let p = ConvergencePoint { strategy: strategy.name().into(), spp, seconds: out.seconds, mse: d.mse, rmse: d.rmse, rel_mse: d.rel_mse };
+            on_point(&p);
+            points.push(p);
+            let over = study.time_budget.is_some_and(|t| out.seconds > t);
+            last = Some((spp, out.pixels));
+            if over {
+                break;
+            }
+        }
+        if let Some((spp, pixels)) = last {
+            finals.push(FinalImage { strategy, spp, pixels });
+        }
+    }
+    Ok((points, finals))
+}
 
 /// One render of a study, measured against the reference.
 #[derive(Clone, Debug, PartialEq)]

@@ -5,10 +5,13 @@ pub mod bench;
 pub mod compare;
 pub mod bake;
 pub mod converge;
+pub mod heatmap;
+pub mod merge;
 pub mod rayfile;
 pub mod report;
 pub mod robustness;
 pub mod rays;
+pub mod sweep;
 pub mod trace;
 
 pub use rays::{RayKind, RaySet};

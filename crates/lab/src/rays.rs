@@ -38,13 +38,19 @@ pub struct RaySet {
     pub rays: Vec<Ray>,
 }
 
+/// One camera ray through the centre of each pixel of a `width × height` grid, row by row
+/// from the top.
+pub fn primary(scene: &Scene, width: u32, height: u32) -> Vec<Ray> {
+    (0..height)
+        .flat_map(|y| (0..width).map(move |x| (x, y)))
+        .map(|(x, y)| scene.camera.ray(Vec2::new((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32), Vec2::splat(0.5)))
+        .collect()
+}
+
 /// Generates the requested ray sets for `scene` at `width × height` camera rays, using the
 /// scene's own structure to find the primary hits. Deterministic for a given `seed`.
 pub fn generate(scene: &Scene, width: u32, height: u32, kinds: &[RayKind], seed: u64) -> Vec<RaySet> {
-    let primary: Vec<Ray> = (0..height)
-        .flat_map(|y| (0..width).map(move |x| (x, y)))
-        .map(|(x, y)| scene.camera.ray(Vec2::new((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32), Vec2::splat(0.5)))
-        .collect();
+    let primary = primary(scene, width, height);
     let lights: Vec<&Light> = scene.lights.iter().filter(|l| !matches!(l, Light::Ambient { .. })).collect();
     let secondary: Vec<(Option<Ray>, Option<Ray>)> = primary
         .par_iter()

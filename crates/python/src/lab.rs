@@ -1,21 +1,21 @@
 //! The lab from Python: bench, compare and converge, returning the plain dicts of the JSON
-//! schema (docs/bench.md) ready for pandas. The method is the CLI's: ray sets generated once
-//! per scene, builds and traces repeated with a warm-up, medians, every structure checked
-//! against an oracle.
+//! schema (docs/bench.md) ready for pandas. The method is the lab's (`raylab_lab::sweep`), the
+//! one `raylab bench` runs: ray sets generated once per scene, builds and traces repeated with
+//! a warm-up, medians, every structure checked against an oracle.
 
-use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use numpy::{PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Primitives};
+use raylab_accel::AccelKind;
 use raylab_core::Rgb;
-use raylab_lab::bench::{median, BenchReport, BenchResult, Machine, RayFigures};
+use raylab_lab::bench::BenchReport;
+use raylab_lab::sweep::{self, BenchSettings, LabError, Progress};
 use raylab_lab::compare::{compare as compare_images, ImageDiff};
-use raylab_lab::converge::{spp_slope, strategies as strategy_names, ConvergencePoint};
-use raylab_lab::{rays, RayKind, TraceResult};
+use raylab_lab::converge::{measure, render_with, spp_slope, strategies as strategy_names, Study, REFERENCE_SEED_XOR};
+use raylab_lab::RayKind;
 use raylab_loader::image_io::read_image;
 use raylab_loader::Overrides;
 use raylab_render::light::LightSampling;
@@ -41,24 +41,6 @@ fn string_list(v: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
     v.extract()
 }
 
-fn cpu_name() -> String {
-    std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|s| s.lines().find(|l| l.starts_with("model name")).and_then(|l| l.split(':').nth(1)).map(|s| s.trim().to_string()))
-        .unwrap_or_else(|| std::env::consts::ARCH.to_string())
-}
-
-struct BenchJob {
-    scenes: Vec<Option<PathBuf>>,
-    accels: Vec<AccelKind>,
-    all: bool,
-    kinds: Vec<RayKind>,
-    resolution: u32,
-    repeats: u32,
-    oracle_limit: usize,
-    seed: u64,
-}
-
 /// Errors of a job on another thread, turned into exceptions on the caller's.
 enum JobError {
     Load(raylab_loader::LoadError),
@@ -74,84 +56,22 @@ impl From<JobError> for PyErr {
     }
 }
 
-fn bench_scene(job: &BenchJob, path: Option<&PathBuf>, cancel: &interrupt::Cancel) -> Result<Vec<BenchResult>, JobError> {
-    let name = path.map_or("default scene".to_string(), |p| p.display().to_string());
-    let o = Overrides { accel: Some(AccelKind::Bvh), ..Default::default() };
-    let scene = match path {
-        Some(p) => raylab_loader::load_scene_or_mesh(p, &o),
-        None => raylab_loader::default_scene(&o),
-    }
-    .map_err(JobError::Load)?;
-    let prims = &scene.geometry;
-    let height = ((job.resolution as f64 * scene.settings.height as f64 / scene.settings.width as f64).round() as u32).max(1);
-    let sets = rays::generate(&scene, job.resolution, height, &job.kinds, job.seed);
-    let oracle_kind = if prims.len() <= job.oracle_limit { AccelKind::None } else { AccelKind::Bvh };
-    // As in the CLI: `all` leaves out the linear structures on scenes above the oracle limit.
-    let linear = [AccelKind::None, AccelKind::Aabb];
-    let accels: Vec<AccelKind> = job.accels.iter().copied().filter(|k| !(job.all && oracle_kind != AccelKind::None && linear.contains(k))).collect();
-    let oracle = AnyAccel::build(oracle_kind, prims, &BuildOptions::default());
-    let reference: Vec<TraceResult> = sets.iter().map(|s| raylab_lab::trace(&oracle, prims, &s.rays, s.kind.any_hit())).collect();
-    let mut built = Vec::new();
-    for &k in &accels {
-        let mut times = Vec::new();
-        let mut accel = None;
-        for _ in 0..job.repeats {
-            let x = AnyAccel::build(k, prims, &BuildOptions::default());
-            times.push(x.stats().build_ms);
-            accel = Some(x);
-        }
-        let accel = accel.expect("repeats >= 1");
-        accel.validate(prims).map_err(|e| JobError::Other(format!("{name}: {k} failed validation: {e}")))?;
-        built.push((k, accel, median(times)));
-    }
-    // Pass 0 is the warm-up; structures interleave within each pass.
-    let mut times = vec![vec![Vec::new(); sets.len()]; built.len()];
-    let mut last = vec![vec![TraceResult::default(); sets.len()]; built.len()];
-    for pass in 0..=job.repeats {
-        if cancel.is_set() {
-            return Err(JobError::Other("interrupted".into()));
-        }
-        for (i, (_, accel, _)) in built.iter().enumerate() {
-            for (j, s) in sets.iter().enumerate() {
-                let r = raylab_lab::trace(accel, prims, &s.rays, s.kind.any_hit());
-                if pass > 0 {
-                    times[i][j].push(r.seconds);
-                }
-                last[i][j] = r;
-            }
+impl From<LabError> for JobError {
+    fn from(e: LabError) -> Self {
+        match e {
+            LabError::Load(e) => JobError::Load(e),
+            e => JobError::Other(e.to_string()),
         }
     }
-    let mut out = Vec::new();
-    let mut mismatches = Vec::new();
-    for (i, (k, accel, build_ms)) in built.iter().enumerate() {
-        let stats = accel.stats();
-        let mut figures = BTreeMap::new();
-        for (j, s) in sets.iter().enumerate() {
-            let r = last[i][j];
-            if !r.agrees_with(&reference[j]) {
-                mismatches.push(format!("{k} on {} rays: {} hits, t sum {} (oracle {oracle_kind}: {} hits, t sum {})", s.kind, r.hits, r.t_sum, reference[j].hits, reference[j].t_sum));
-            }
-            let secs = median(times[i][j].clone());
-            let n = r.count.max(1) as f64;
-            figures.insert(
-                s.kind.name().to_string(),
-                RayFigures {
-                    count: r.count,
-                    hits: r.hits,
-                    t_sum: r.t_sum,
-                    mrays_per_s: r.count as f64 / secs.max(1e-12) / 1e6,
-                    node_visits_per_ray: r.counters.nodes_visited as f64 / n,
-                    prim_tests_per_ray: r.counters.prim_tests as f64 / n,
-                    object_tests_per_ray: r.counters.object_tests as f64 / n,
-                },
-            );
-        }
-        out.push(BenchResult { scene: name.clone(), primitives: prims.len(), accel: k.name().into(), build_ms: *build_ms, memory_bytes: stats.memory_bytes, stats, rays: figures });
+}
+
+/// The sweep's progress from Python: only Ctrl-C matters.
+struct CancelOnInterrupt(interrupt::Cancel);
+
+impl Progress for CancelOnInterrupt {
+    fn cancelled(&self) -> bool {
+        self.0.is_set()
     }
-    if !mismatches.is_empty() {
-        return Err(JobError::Other(format!("{name}: answers differ from the oracle:\n  {}", mismatches.join("\n  "))));
-    }
-    Ok(out)
 }
 
 /// `raylab.bench`: every structure on the same rays; the `raylab bench --json` dict.
@@ -186,15 +106,22 @@ pub fn bench(
     let all = accel_names == ["all"];
     let accels = if all { AccelKind::ALL.to_vec() } else { names::<AccelKind>("accels", &accel_names)? };
     let kinds = names::<RayKind>("rays", &rays.map(string_list).transpose()?.unwrap_or_else(|| vec!["primary".into(), "diffuse".into(), "shadow".into()]))?;
-    let job = BenchJob { scenes, accels, all, kinds, resolution, repeats, oracle_limit, seed };
+    let settings = BenchSettings {
+        scenes,
+        accels: accels.iter().map(|k| k.name().to_string()).collect(),
+        all,
+        rays: kinds.iter().map(|k| k.name().to_string()).collect(),
+        resolution,
+        repeats,
+        oracle_limit,
+        seed,
+        heatmap_width: None,
+    };
     let pool = settings::pool(threads)?;
     let report = interrupt::run(py, move |cancel| {
         settings::install(pool.as_ref(), || -> Result<BenchReport, JobError> {
-            let mut results = Vec::new();
-            for p in &job.scenes {
-                results.extend(bench_scene(&job, p.as_ref(), &cancel)?);
-            }
-            Ok(BenchReport { machine: Machine { cpu: cpu_name(), threads: rayon::current_num_threads() }, raylab_version: env!("CARGO_PKG_VERSION").into(), repeats: job.repeats, resolution: job.resolution, results })
+            let jobs = sweep::jobs(&settings)?;
+            Ok(sweep::run(&settings, &jobs, None, None, &CancelOnInterrupt(cancel))?)
         })
     })??;
     to_py(py, &report)
@@ -287,12 +214,6 @@ pub fn converge<'py>(
                 st.sampler.check_spp(n).map_err(|e| JobError::Other(format!("spp: {e}")))?;
             }
             let (w, h) = (st.width, st.height);
-            let mut render_with = |strategy: LightSampling, spp: u32, seed: u64| {
-                scene.settings.light_sampling = strategy;
-                scene.settings.spp = spp;
-                scene.settings.seed = seed;
-                raylab_render::render(&scene, &|_| {})
-            };
             let ref_pixels = match reference {
                 Some((rw, rh, px)) => {
                     if (rw, rh) != (w, h) {
@@ -302,22 +223,12 @@ pub fn converge<'py>(
                 }
                 None => {
                     st.sampler.check_spp(reference_spp).map_err(|e| JobError::Other(format!("reference_spp: {e}")))?;
-                    // Another seed, as in the CLI: a reference sharing the renders' random
-                    // streams would correlate with them and understate their error.
-                    render_with(LightSampling::Mis, reference_spp, st.seed ^ 0x9e37_79b9_7f4a_7c15).pixels
+                    render_with(&mut scene, LightSampling::Mis, reference_spp, st.seed ^ REFERENCE_SEED_XOR).pixels
                 }
             };
-            let mut points = Vec::new();
-            for &strategy in &strategy_list {
-                for &n in &spps {
-                    if cancel.is_set() {
-                        return Err(JobError::Other("interrupted".into()));
-                    }
-                    let out = render_with(strategy, n, st.seed);
-                    let d = compare_images(&out.pixels, &ref_pixels, w, exclude_bright).map_err(|e| JobError::Other(format!("{strategy} at {n} spp: {e}")))?;
-                    points.push(ConvergencePoint { strategy: strategy.name().into(), spp: n, seconds: out.seconds, mse: d.mse, rmse: d.rmse, rel_mse: d.rel_mse });
-                }
-            }
+            scene.settings.seed = st.seed;
+            let study = Study { strategies: &strategy_list, spps: &spps, time_budget: None, exclude_bright };
+            let (points, _) = measure(&mut scene, &ref_pixels, &study, &mut |_| {}, &|| cancel.is_set()).map_err(JobError::Other)?;
             Ok((w, h, points, ref_pixels))
         })
     })??;

@@ -16,7 +16,8 @@ def test_bench_dict_matches_the_cli_schema_and_answers(cli, repo, tmp_path):
     c = run_cli(cli, "bench", scene, "--accels", "bvh,kdtree,none", "--resolution", "32", "--repeats", "1", "--json", out)
     assert c.returncode == 0, c.stderr
     cli_report = json.loads(out.read_text())
-    assert set(r) == set(cli_report) == {"machine", "raylab_version", "repeats", "resolution", "results"}
+    assert set(r) == set(cli_report) == {"machine", "raylab_version", "repeats", "resolution", "results", "settings", "jobs"}
+    assert r["jobs"]["ran"] == cli_report["jobs"]["ran"] == list(range(9))
     assert [x["accel"] for x in r["results"]] == ["bvh", "kdtree", "none"]
     for mine, theirs in zip(r["results"], cli_report["results"]):
         assert set(mine) == set(theirs)

@@ -12,7 +12,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Primitives};
 use raylab_core::{Ray, Vec3};
-use raylab_lab::bench::{median, Machine};
+use raylab_lab::bench::{cpu_name, median, Machine};
 use raylab_lab::{rays, RayKind};
 use raylab_loader::Overrides;
 use raylab_peers::harness::{self, Timing, TilePackets};
@@ -20,7 +20,7 @@ use raylab_peers::table::{self, Clock, Row, Speed};
 use raylab_peers::{agree, Peer, PeerHit, PeerKind, RaylabPeer};
 use serde::Serialize;
 
-use super::bench::{cpu_name, parse_accels, BenchArgs};
+use super::bench::BenchArgs;
 
 /// The name of the packet ray set: the primary rays in 4×4 tiles, 16 rays per call for
 /// structures with a packet kernel (Embree's `rtcIntersect16`), one by one for the others.
@@ -88,7 +88,7 @@ pub fn run(a: &BenchArgs, peers: &str) -> Result<()> {
         bail!("--peers writes tables and --json only: leave out --report and --dump-rays (run `raylab bench` without --peers for them)");
     }
     // raylab's best structure by default (docs/performance.md); any list by name.
-    let accels = if a.accels == "all" { vec![AccelKind::Bvh8] } else { parse_accels(&a.accels)? };
+    let accels = if a.accels == "all" { vec![AccelKind::Bvh8] } else { raylab_lab::sweep::parse_list::<AccelKind>("--accels", &a.accels).map_err(|e| anyhow::anyhow!("{e}"))? };
     let kinds: Vec<RayKind> = a.rays.split(',').map(|s| s.trim().parse::<RayKind>().map_err(|e| anyhow::anyhow!("--rays: {e}"))).collect::<Result<_>>()?;
     if let Some(p) = &a.json {
         raylab_render::film::atomic::check_writable(p).map_err(|e| anyhow::anyhow!("{e}"))?;

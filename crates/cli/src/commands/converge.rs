@@ -6,12 +6,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
-use raylab_lab::compare::compare;
-use raylab_lab::converge::{csv, html, spp_slope, strategies, ConvergencePoint, LabelledImage};
+use raylab_lab::converge::{csv, html, measure, render_with, spp_slope, strategies, ConvergencePoint, LabelledImage, Study, REFERENCE_SEED_XOR};
 use raylab_loader::image_io::{encode_png, read_image, write_image, Tonemap};
 use raylab_loader::Overrides;
 use raylab_render::light::LightSampling;
-use raylab_render::{render, IntegratorKind, Scene};
+use raylab_render::{IntegratorKind, Scene};
 
 use super::scene_args::SettingsArgs;
 
@@ -89,8 +88,7 @@ pub fn run(a: &ConvergeArgs) -> Result<()> {
             None => {
                 // Another seed: a reference sharing the renders' random streams would correlate
                 // with them and understate their error.
-                scene.settings.seed = seed ^ 0x9e37_79b9_7f4a_7c15;
-                let pixels = render_with(&mut scene, LightSampling::Mis, a.reference_spp).pixels;
+                let pixels = render_with(&mut scene, LightSampling::Mis, a.reference_spp, seed ^ REFERENCE_SEED_XOR).pixels;
                 scene.settings.seed = seed;
                 let path = a.output.join("reference.exr");
                 write_image(&path, w, h, &pixels, Tonemap::Clamp, 0.0)?;
@@ -98,25 +96,14 @@ pub fn run(a: &ConvergeArgs) -> Result<()> {
                 (pixels, format!("reference (mis, {} spp, another seed)", a.reference_spp))
             }
         };
-        let mut points = Vec::new();
-        let mut images = Vec::new();
         println!("{:<12} {:>7} {:>9} {:>12} {:>12}", "strategy", "spp", "seconds", "MSE", "relMSE");
-        for &strategy in &strategy_list {
-            let mut last = None;
-            for &spp in &spps {
-                let out = render_with(&mut scene, strategy, spp);
-                let d = compare(&out.pixels, &reference, w, a.exclude_bright).map_err(|e| anyhow!("{strategy} at {spp} spp: {e}"))?;
-                println!("{:<12} {spp:>7} {:>9.3} {:>12.4e} {:>12.4e}", strategy.name(), out.seconds, d.mse, d.rel_mse);
-                points.push(ConvergencePoint { strategy: strategy.name().into(), spp, seconds: out.seconds, mse: d.mse, rmse: d.rmse, rel_mse: d.rel_mse });
-                let over = a.time_budget.is_some_and(|t| out.seconds > t);
-                last = Some((spp, out.pixels));
-                if over {
-                    break;
-                }
-            }
-            let (spp, pixels) = last.expect("at least one spp");
-            write_image(&a.output.join(format!("{strategy}_{spp}.exr")), w, h, &pixels, Tonemap::Clamp, 0.0)?;
-            images.push(LabelledImage { label: format!("{strategy}, {spp} spp"), png: encode_png(w, h, &pixels, Tonemap::Clamp, 0.0)? });
+        let study = Study { strategies: &strategy_list, spps: &spps, time_budget: a.time_budget, exclude_bright: a.exclude_bright };
+        let mut show = |p: &ConvergencePoint| println!("{:<12} {:>7} {:>9.3} {:>12.4e} {:>12.4e}", p.strategy, p.spp, p.seconds, p.mse, p.rel_mse);
+        let (points, finals) = measure(&mut scene, &reference, &study, &mut show, &|| false).map_err(|e| anyhow!(e))?;
+        let mut images = Vec::new();
+        for f in &finals {
+            write_image(&a.output.join(format!("{}_{}.exr", f.strategy, f.spp)), w, h, &f.pixels, Tonemap::Clamp, 0.0)?;
+            images.push(LabelledImage { label: format!("{}, {} spp", f.strategy, f.spp), png: encode_png(w, h, &f.pixels, Tonemap::Clamp, 0.0)? });
         }
         images.push(LabelledImage { label: reference_label.clone(), png: encode_png(w, h, &reference, Tonemap::Clamp, 0.0)? });
         println!("slope of ln MSE against ln spp (least squares; -1 for independent samples):");
@@ -128,13 +115,6 @@ pub fn run(a: &ConvergeArgs) -> Result<()> {
         write(&a.output.join("convergence.html"), html(&intro, &points, &images))?;
         Ok(())
     })
-}
-
-/// Renders `scene` with `strategy` at `spp`; neither needs the acceleration structure rebuilt.
-fn render_with(scene: &mut Scene, strategy: LightSampling, spp: u32) -> raylab_render::RenderOutput {
-    scene.settings.light_sampling = strategy;
-    scene.settings.spp = spp;
-    render(scene, &|_| {})
 }
 
 fn write(path: &Path, text: String) -> Result<()> {
