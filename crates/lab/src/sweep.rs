@@ -62,6 +62,14 @@ impl BenchSettings {
     }
 }
 
+/// The structures of an `--accels` list: comma-separated names, or `all` for every one.
+pub fn parse_accels(option: &str, list: &str) -> Result<Vec<AccelKind>, LabError> {
+    if list.trim() == "all" {
+        return Ok(AccelKind::ALL.to_vec());
+    }
+    parse_list(option, list)
+}
+
 /// Parses a comma-separated list of names, naming the option in errors.
 pub fn parse_list<T: std::str::FromStr>(option: &str, list: &str) -> Result<Vec<T>, LabError>
 where

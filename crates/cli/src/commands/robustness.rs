@@ -5,7 +5,6 @@ use anyhow::{bail, Result};
 use clap::Args;
 use raylab_lab::robustness::{measure, PrimKind, Robustness, SCALES};
 
-use super::bench::parse_accels;
 
 #[derive(Args, Clone, Debug)]
 pub struct RobustnessArgs {
@@ -25,7 +24,7 @@ pub fn run(a: &RobustnessArgs) -> Result<()> {
     if a.rays == 0 {
         bail!("--rays: expected at least 1");
     }
-    let kinds = parse_accels(&a.accels)?;
+    let kinds = raylab_lab::sweep::parse_accels("--accels", &a.accels).map_err(|e| anyhow::anyhow!("{e}"))?;
     let r = measure(&kinds, &SCALES, a.rays);
     if a.json {
         println!("{}", serde_json::to_string_pretty(&r)?);
