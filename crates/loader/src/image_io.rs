@@ -23,7 +23,7 @@ fn extension(path: &Path) -> String {
 /// Reads an image as linear RGB, top row first. 8-bit formats are decoded from sRGB when
 /// `srgb` is true (colour maps), taken as linear otherwise (normal maps, masks).
 pub fn read_image(path: &Path, srgb: bool) -> Result<(u32, u32, Vec<Rgb>), ImageError> {
-    let bytes = std::fs::read(path).map_err(|e| err(path, format!("cannot read: {e}")))?;
+    let bytes = crate::files::read_capped(path, crate::files::MAX_DATA_BYTES).map_err(|e| err(path, e.message))?;
     decode_image(path, &bytes, srgb)
 }
 

@@ -527,6 +527,7 @@ impl Parser {
                     let found = Resolver::Disk { base }.find(&file).map_err(|tried| span.err(not_found_message(&file, &tried)))?;
                     let (w, h, texels) = crate::image_io::read_image(&found.path(), false).map_err(|e| span.err(e.to_string()))?;
                     let image = ImageTexture::new(w, h, texels, Wrap::Repeat, Filter::Bilinear).map_err(|e| span.err(e.to_string()))?;
+                    EnvironmentLight::check_image(&image).map_err(|e| span.err(format!("{}: {e}", found.path().display())))?;
                     self.desc.environment = Some(EnvironmentLight::new(image, Rgb::splat(scale)));
                 }
                 None => self.desc.background = Background::Color(self.rgb(d, "L", Rgb::ONE)? * scale),
