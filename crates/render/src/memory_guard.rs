@@ -68,13 +68,15 @@ fn check_against(what: &str, bytes: Option<u64>, memory: Option<u64>) -> Result<
     }
 }
 
-/// Bytes in GiB or MiB with one decimal, for messages.
+/// Bytes in GiB, MiB or KiB with one decimal, for messages.
 pub fn human(bytes: u64) -> String {
-    let gib = bytes as f64 / (1u64 << 30) as f64;
-    if gib >= 1.0 {
-        format!("{gib:.1} GiB")
+    let b = bytes as f64;
+    if bytes >= 1 << 30 {
+        format!("{:.1} GiB", b / (1u64 << 30) as f64)
+    } else if bytes >= 1 << 20 {
+        format!("{:.1} MiB", b / (1u64 << 20) as f64)
     } else {
-        format!("{:.1} MiB", bytes as f64 / (1u64 << 20) as f64)
+        format!("{:.1} KiB", b / 1024.0)
     }
 }
 
