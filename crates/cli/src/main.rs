@@ -13,6 +13,9 @@ use clap::{Parser, Subcommand};
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
+    /// Allow images, meshes and files that need more memory than this machine (or job, or RAYLAB_MEMORY_LIMIT) has; they are refused otherwise
+    #[arg(long, global = true)]
+    allow_large: bool,
 }
 
 #[derive(Subcommand)]
@@ -40,7 +43,9 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let result = match command_of(Cli::parse()) {
+    let cli = Cli::parse();
+    raylab_render::memory_guard::allow_large(cli.allow_large);
+    let result = match command_of(cli) {
         Command::Render(a) => commands::render::run(&a),
         Command::Inspect(a) => commands::inspect::run(&a),
         Command::Gen(a) => commands::gen::run(&a),

@@ -28,6 +28,13 @@ pub fn write(path: &Path, rays: &[Ray]) -> Result<(), RayFileError> {
 }
 
 pub fn read(path: &Path) -> Result<Vec<Ray>, RayFileError> {
+    // Only a regular file has an end: `/dev/zero` or a folder would read until memory is
+    // exhausted, or fail with a puzzling message.
+    let meta = std::fs::metadata(path).map_err(|e| err(path, format!("cannot open: {e}")))?;
+    if !meta.is_file() {
+        return Err(err(path, "is not a regular file (a folder or a device)"));
+    }
+    raylab_render::memory_guard::check("reading it", Some(meta.len())).map_err(|e| err(path, e))?;
     let mut f = std::fs::File::open(path).map_err(|e| err(path, format!("cannot open: {e}")))?;
     let mut bytes = Vec::new();
     f.read_to_end(&mut bytes).map_err(|e| err(path, format!("cannot read: {e}")))?;
@@ -68,6 +75,9 @@ mod tests {
         assert_eq!(read(&p).unwrap_err().to_string(), format!("{}: the header says 1 rays (32 bytes) but 2 bytes follow", p.display()));
         std::fs::write(&p, [1u8, 2]).unwrap();
         assert_eq!(read(&p).unwrap_err().to_string(), format!("{}: too short for a ray file (2 bytes; the header alone is 8)", p.display()));
+        assert_eq!(read(&dir).unwrap_err().to_string(), format!("{}: is not a regular file (a folder or a device)", dir.display()));
+        #[cfg(unix)]
+        assert_eq!(read(Path::new("/dev/zero")).unwrap_err().to_string(), "/dev/zero: is not a regular file (a folder or a device)");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -9,9 +9,9 @@ use raylab_render::MaterialId;
 
 use crate::description::SceneDescription;
 
-use crate::error::{text_from_bytes, LoadError};
+use crate::error::{shorten, text_from_bytes, LoadError};
 use crate::files::Found;
-use crate::toml_read::{in_range, Table, Val};
+use crate::toml_read::{in_range, positive, Table, Val};
 
 /// The keys of a curve shape besides `type`, `material` and `transform`.
 pub const KEYS: &[&str] = &["points", "radius", "basis", "degree", "file", "mode", "segments", "sides"];
@@ -49,7 +49,7 @@ pub fn add_curves(scene: &mut SceneDescription, t: &Table, file: Option<(Val, Fo
             let is_hair = path.to_string_lossy().trim_end_matches(".gz").ends_with(".hair");
             let default_radius = match &radius_v {
                 Some(v) if is_hair => return Err(v.err("not used with .hair files, which give every point's thickness")),
-                Some(v) => non_negative(v, v.f32()?)?,
+                Some(v) => positive(v, v.f32()?)?,
                 None => DEFAULT_RADIUS,
             };
             let bytes = found.read()?;
@@ -58,6 +58,10 @@ pub fn add_curves(scene: &mut SceneDescription, t: &Table, file: Option<(Val, Fo
                 return Err(fv.err(format!("{}: no strands", path.display())));
             }
             for (k, s) in read.iter().enumerate() {
+                // As a sphere of radius 0: a curve with no thickness anywhere is invisible.
+                if s.points.iter().all(|p| p.w == 0.0) {
+                    return Err(LoadError::new(&path, s.line, "", format!("strand {k}: every radius is 0: the curve would have no thickness")));
+                }
                 strands.push(segments_of(&s.points).map_err(|e| LoadError::new(&path, s.line, "", format!("strand {k}: {e}")))?);
             }
         }
@@ -96,19 +100,24 @@ fn non_negative(v: &Val, r: f32) -> Result<f32, LoadError> {
     if r >= 0.0 { Ok(r) } else { Err(v.err(format!("must not be negative, found {r}"))) }
 }
 
-/// `radius`: one number for every point, or one per point.
+/// `radius`: one positive number for every point, or one per point (0 allowed, at a
+/// tapered tip, but not everywhere).
 fn radii(v: &Val, n: usize) -> Result<Vec<f32>, LoadError> {
     if let Ok(r) = v.f32() {
-        return Ok(vec![non_negative(v, r)?; n]);
+        return Ok(vec![positive(v, r)?; n]);
     }
     let a = v.array().map_err(|_| v.err("expected a number or an array of one number per point"))?;
     if a.len() != n {
         return Err(v.err(format!("expected {n} radii (one per point), found {}", a.len())));
     }
-    a.iter().enumerate().map(|(k, e)| {
+    let radii = a.iter().enumerate().map(|(k, e)| {
         let ev = Val { doc: v.doc, field: format!("{}[{k}]", v.field), value: e };
         non_negative(&ev, ev.f32()?)
-    }).collect()
+    }).collect::<Result<Vec<f32>, _>>()?;
+    if radii.iter().all(|&r| r == 0.0) {
+        return Err(v.err("must not all be 0: the curve would have no thickness"));
+    }
+    Ok(radii)
 }
 
 /// The text format: `strand` starts a strand, then one control point per line,
@@ -126,7 +135,7 @@ fn read_text(path: &std::path::Path, text: String, default_radius: f32) -> Resul
             continue;
         }
         let err = |msg: String| LoadError::new(path, Some(line_no), "", msg);
-        let numbers: Vec<f32> = line.split_whitespace().map(|w| w.parse::<f32>().ok().filter(|x| x.is_finite())).collect::<Option<_>>().ok_or_else(|| err(format!("expected `strand` or a point `x y z [radius]`, found `{line}`")))?;
+        let numbers: Vec<f32> = line.split_whitespace().map(|w| w.parse::<f32>().ok().filter(|x| x.is_finite())).collect::<Option<_>>().ok_or_else(|| err(format!("expected `strand` or a point `x y z [radius]`, found `{}`", shorten(line))))?;
         let radius = match numbers.len() {
             3 => default_radius,
             4 if numbers[3] >= 0.0 => numbers[3],

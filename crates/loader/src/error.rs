@@ -31,7 +31,7 @@ impl fmt::Display for LoadError {
             write!(f, ":{line}")?;
         }
         if !self.field.is_empty() {
-            write!(f, ": {}", self.field)?;
+            write!(f, ": {}", shorten(&self.field))?;
         }
         write!(f, ": {}", self.message)
     }
@@ -39,10 +39,21 @@ impl fmt::Display for LoadError {
 
 impl std::error::Error for LoadError {}
 
-/// Reads a text file, naming the file in every error, and the line of the first byte that
-/// is not UTF-8.
+/// Text from a file as a message shows it: whole when short, else its start and its size,
+/// so that a 10 MB key or line does not come back in full.
+pub fn shorten(text: &str) -> String {
+    const KEEP: usize = 60;
+    if text.chars().count() <= KEEP + 20 {
+        return text.to_string();
+    }
+    let head: String = text.chars().take(KEEP).collect();
+    format!("{head}... ({} bytes)", text.len())
+}
+
+/// Reads a scene's text (at most [`crate::files::MAX_SCENE_BYTES`]), naming the file in
+/// every error, and the line of the first byte that is not UTF-8.
 pub fn read_text(path: &Path) -> Result<String, LoadError> {
-    let bytes = std::fs::read(path).map_err(|e| LoadError::file(path, format!("cannot read: {e}")))?;
+    let bytes = crate::files::read_capped(path, crate::files::MAX_SCENE_BYTES)?;
     text_from_bytes(path, bytes)
 }
 

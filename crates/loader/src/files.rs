@@ -6,6 +6,7 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use crate::error::LoadError;
+use raylab_render::memory_guard::human;
 
 /// Files compiled into the binary for the default scene.
 const EMBEDDED: &[(&str, &[u8])] = &[("bunny_4968.obj", include_bytes!("../../../assets/bunny_4968.obj"))];
@@ -39,12 +40,16 @@ impl Found {
     pub fn read(&self) -> Result<Vec<u8>, LoadError> {
         let path = self.path();
         let raw = match self {
-            Found::Disk(p) => std::fs::read(p).map_err(|e| LoadError::file(&path, format!("cannot read: {e}")))?,
+            Found::Disk(p) => read_capped(p, MAX_DATA_BYTES)?,
             Found::Embedded(_, bytes) => bytes.to_vec(),
         };
         if path.extension().is_some_and(|e| e == "gz") {
+            // Capped too: a few kilobytes of gzip can expand to terabytes.
             let mut out = Vec::new();
-            flate2::read::GzDecoder::new(raw.as_slice()).read_to_end(&mut out).map_err(|e| LoadError::file(&path, format!("cannot decompress: {e}")))?;
+            flate2::read::GzDecoder::new(raw.as_slice()).take(MAX_DATA_BYTES + 1).read_to_end(&mut out).map_err(|e| LoadError::file(&path, format!("cannot decompress: {e}")))?;
+            if out.len() as u64 > MAX_DATA_BYTES {
+                return Err(LoadError::file(&path, format!("decompresses to more than {}, the most raylab reads from one file", human(MAX_DATA_BYTES))));
+            }
             return Ok(out);
         }
         Ok(raw)
@@ -69,7 +74,9 @@ impl Resolver {
             Resolver::Disk { base } => {
                 let mut tried = Vec::new();
                 let direct = base.join(name);
-                if direct.is_file() {
+                // Anything that exists is found (a folder or a device too), so that reading it
+                // says what it is rather than "cannot find".
+                if direct.exists() {
                     return Ok(Found::Disk(direct));
                 }
                 tried.push(direct);
@@ -80,7 +87,7 @@ impl Resolver {
                     let abs = std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf());
                     for dir in abs.ancestors() {
                         let candidate = dir.join("shared").join("scenes").join(name);
-                        if candidate.is_file() {
+                        if candidate.exists() {
                             return Ok(Found::Disk(candidate));
                         }
                         if dir.join("shared").join("scenes").is_dir() {
@@ -92,6 +99,53 @@ impl Resolver {
             }
         }
     }
+}
+
+/// The largest scene text (TOML, pbrt) raylab reads: a scene file is settings and names;
+/// its geometry lives in the files it names. An endless input (`/dev/zero`, a pipe that
+/// never ends) stops here with an error instead of exhausting memory.
+pub const MAX_SCENE_BYTES: u64 = 256 << 20;
+/// The largest data file (mesh, curves, patches, image), and the largest a `.gz` may
+/// decompress to.
+pub const MAX_DATA_BYTES: u64 = 32 << 30;
+
+/// Reads a whole file of at most `cap` bytes. A folder or a device is refused by name; a
+/// regular file larger than `cap` (or than the machine's memory, unless --allow-large) is
+/// refused before reading; a pipe is read up to `cap` bytes.
+pub fn read_capped(path: &Path, cap: u64) -> Result<Vec<u8>, LoadError> {
+    let fail = |m: String| LoadError::file(path, m);
+    let meta = std::fs::metadata(path).map_err(|e| fail(format!("cannot read: {e}")))?;
+    let kind = meta.file_type();
+    if kind.is_dir() {
+        return Err(fail("is a folder, not a file".into()));
+    }
+    if is_device(&kind) {
+        return Err(fail("is a device, not a regular file".into()));
+    }
+    if kind.is_file() {
+        if meta.len() > cap {
+            return Err(fail(format!("is {} bytes ({}), more than the {} raylab reads from one such file", meta.len(), human(meta.len()), human(cap))));
+        }
+        raylab_render::memory_guard::check("reading it", Some(meta.len())).map_err(fail)?;
+    }
+    let file = std::fs::File::open(path).map_err(|e| fail(format!("cannot read: {e}")))?;
+    let mut bytes = Vec::new();
+    file.take(cap + 1).read_to_end(&mut bytes).map_err(|e| fail(format!("cannot read: {e}")))?;
+    if bytes.len() as u64 > cap {
+        return Err(fail(format!("more than {} (the most raylab reads from one such file): is it endless?", human(cap))));
+    }
+    Ok(bytes)
+}
+
+#[cfg(unix)]
+fn is_device(kind: &std::fs::FileType) -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    kind.is_block_device() || kind.is_char_device()
+}
+
+#[cfg(not(unix))]
+fn is_device(_: &std::fs::FileType) -> bool {
+    false
 }
 
 /// "cannot find `x` (looked in a, b)".

@@ -23,7 +23,7 @@ fn extension(path: &Path) -> String {
 /// Reads an image as linear RGB, top row first. 8-bit formats are decoded from sRGB when
 /// `srgb` is true (colour maps), taken as linear otherwise (normal maps, masks).
 pub fn read_image(path: &Path, srgb: bool) -> Result<(u32, u32, Vec<Rgb>), ImageError> {
-    let bytes = std::fs::read(path).map_err(|e| err(path, format!("cannot read: {e}")))?;
+    let bytes = crate::files::read_capped(path, crate::files::MAX_DATA_BYTES).map_err(|e| err(path, e.message))?;
     decode_image(path, &bytes, srgb)
 }
 
@@ -54,6 +54,14 @@ fn read_8bit(path: &Path, bytes: &[u8], srgb: bool) -> Result<(u32, u32, Vec<Rgb
 
 fn read_exr(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Vec<Rgb>), ImageError> {
     use exr::prelude::*;
+    // The pixel buffer is sized from the header before any pixel is read, and compression
+    // lets a small file announce a huge image: check the announced sizes first.
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false).map_err(|e| err(path, format!("cannot decode OpenEXR: {e}")))?;
+    for h in meta.headers.iter() {
+        let (w, ht) = (h.layer_size.width(), h.layer_size.height());
+        let bytes = (w as u64).checked_mul(ht as u64).and_then(|n| n.checked_mul(std::mem::size_of::<Rgb>() as u64));
+        raylab_render::memory_guard::check(&format!("its {w}×{ht} layer"), bytes).map_err(|e| err(path, e))?;
+    }
     let image = read()
         .no_deep_data()
         .largest_resolution_level()

@@ -45,7 +45,7 @@ pub fn load_mesh_file(found: &Found, to_world: &Transform) -> Result<ObjData, Lo
     let path = found.path();
     let data = match MeshFormat::require(&path.to_string_lossy()).map_err(|e| LoadError::file(&path, e))? {
         MeshFormat::Obj => load_obj(found, to_world)?,
-        MeshFormat::Ply => ObjData { meshes: vec![(crate::ply::load_ply(found, to_world)?, None)], materials: Vec::new(), mtl_dir: None },
+        MeshFormat::Ply => ObjData { meshes: vec![(crate::ply::load_ply(found, to_world)?, None)], materials: Vec::new(), mtl_dir: None, warnings: Vec::new() },
     };
     // A mesh that yields nothing would render as a silent black image: say so instead.
     let triangles: usize = data.meshes.iter().map(|(m, _)| m.indices.len()).sum();
@@ -58,12 +58,19 @@ pub fn load_mesh_file(found: &Found, to_world: &Transform) -> Result<ObjData, Lo
 /// A bare mesh as a scene: a camera framing its bounds from the front and above, a point
 /// light beside the camera, a little ambient light, the default material.
 pub fn parse_mesh_scene(path: &Path) -> Result<SceneDescription, LoadError> {
-    if !path.is_file() {
+    if !path.exists() {
         return Err(LoadError::file(path, "cannot read: no such file"));
     }
     let data = load_mesh_file(&Found::Disk(path.to_path_buf()), &Transform::IDENTITY)?;
     let meshes: Vec<TriangleMesh> = data.meshes.into_iter().map(|(m, _)| m).collect();
+    // The camera is placed from the bounds: a mesh without extent has no view to frame, and
+    // would otherwise fail with a camera error the user never wrote.
+    let first = meshes.iter().find_map(|m| m.indices.first().map(|t| m.positions[t[0] as usize]));
+    if let Some(first) = first.filter(|&f| meshes.iter().all(|m| m.indices.iter().flatten().all(|&i| m.positions[i as usize] == f))) {
+        return Err(LoadError::file(path, format!("every vertex of its triangles is the same point [{}, {}, {}]: there is nothing to see or frame", first.x, first.y, first.z)));
+    }
     let mut desc = framed_description(path, &meshes);
+    desc.warnings.extend(data.warnings);
     for mesh in meshes {
         desc.geometry.add_mesh(mesh);
     }
@@ -80,7 +87,9 @@ pub fn framed_description(path: &Path, meshes: &[TriangleMesh]) -> SceneDescript
         }
     }
     let center = b.centroid();
-    let radius = (0.5 * b.extent().length()).max(1e-3);
+    // Far from the origin, a camera closer than a few ulps of the centre would coincide
+    // with it in single precision.
+    let radius = (0.5 * b.extent().length()).max(1e-3).max(center.abs().max_element() * 1e-5);
     let from = center + Vec3::new(0.35, 0.45, 1.0).normalize() * radius * 2.6;
     let span = Span::new(path, None, "camera");
     let camera = CameraDescription { from, at: center, up: Vec3::Y, vfov: 40.0, aperture: 0.0, focus_distance: None, at_span: span.clone(), up_span: span };

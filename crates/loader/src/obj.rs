@@ -8,7 +8,7 @@ use std::path::Path;
 use raylab_core::{Rgb, Transform, Vec2, Vec3};
 use raylab_render::TriangleMesh;
 
-use crate::error::{text_from_bytes, LoadError};
+use crate::error::{shorten, text_from_bytes, LoadError};
 use crate::files::{not_found_message, Found};
 
 /// An MTL material, kept as read; the scene loader turns it into a raylab material.
@@ -21,11 +21,14 @@ pub struct ObjData {
     pub materials: Vec<MtlMaterial>,
     /// Where relative texture names in the MTL are looked up.
     pub mtl_dir: Option<Found>,
+    /// What was skipped, said once per file with counts (the caller prints them).
+    pub warnings: Vec<String>,
 }
 
 pub fn load_obj(found: &Found, to_world: &Transform) -> Result<ObjData, LoadError> {
     let path = found.path();
     let text = text_from_bytes(&path, found.read()?)?;
+    let warnings = short_faces_warning(&path, &text).into_iter().collect();
     let opts = tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
     let siblings = found.sibling_resolver();
     // tobj takes an `Fn` material loader, so what it learns is kept in cells.
@@ -39,6 +42,10 @@ pub fn load_obj(found: &Found, to_world: &Transform) -> Result<ObjData, LoadErro
                     *mtl_error.borrow_mut() = Some(e);
                     tobj::LoadError::OpenFileFailed
                 })?;
+                if let Err(e) = check_mtl(&f.path(), &bytes) {
+                    *mtl_error.borrow_mut() = Some(e);
+                    return Err(tobj::LoadError::OpenFileFailed);
+                }
                 *mtl_found.borrow_mut() = Some(f);
                 tobj::load_mtl_buf(&mut Cursor::new(bytes))
             }
@@ -54,26 +61,91 @@ pub fn load_obj(found: &Found, to_world: &Transform) -> Result<ObjData, LoadErro
     }
     let mtl_found = mtl_found.into_inner();
     let materials = materials.map_err(|e| LoadError::file(&mtl_found.as_ref().map_or(path.clone(), |f| f.path()), format!("cannot parse MTL: {e}")))?;
+    // Positions are checked while the text is at hand to name the line; then the text is
+    // freed, and each of tobj's meshes as soon as it is converted, so that the peak is not
+    // the text, tobj's arrays and ours all at once.
+    let mut first_vertex = 0;
+    for model in &models {
+        if let Some(k) = model.mesh.positions.iter().position(|x| !x.is_finite()) {
+            let line = nth_statement_line(&text, "v", first_vertex + k / 3);
+            return Err(LoadError::new(&path, line, "", "vertex position is not a finite number"));
+        }
+        first_vertex += model.mesh.positions.len() / 3;
+    }
+    drop(text);
     let normal_m = |n: Vec3| to_world.normal(n).try_normalize().unwrap_or(Vec3::Y);
     let mut meshes = Vec::new();
     for model in models {
         let m = model.mesh;
         let positions: Vec<Vec3> = m.positions.chunks_exact(3).map(|p| to_world.point(Vec3::new(p[0], p[1], p[2]))).collect();
-        if let Some(k) = positions.iter().position(|p| !p.is_finite()) {
-            let line = nth_statement_line(&text, "v", k);
-            return Err(LoadError::new(&path, line, "", "vertex position is not a finite number"));
+        drop(m.positions);
+        if positions.iter().any(|p| !p.is_finite()) {
+            return Err(LoadError::file(&path, "a vertex position overflows single precision once transformed"));
         }
         let normals: Vec<Vec3> = m.normals.chunks_exact(3).map(|n| normal_m(Vec3::new(n[0], n[1], n[2]))).collect();
+        drop(m.normals);
         let uvs: Vec<Vec2> = m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], t[1])).collect();
+        drop(m.texcoords);
         let normals = if normals.len() == positions.len() && normals.iter().all(|n| n.is_finite()) { normals } else { Vec::new() };
         let uvs = if uvs.len() == positions.len() && uvs.iter().all(|t| t.is_finite()) { uvs } else { Vec::new() };
         let indices = m.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+        drop(m.indices);
         let mesh = TriangleMesh { name: model.name, positions, normals, uvs, indices, ..Default::default() };
         if !mesh.is_empty() {
             meshes.push((mesh, m.material_id));
         }
     }
-    Ok(ObjData { meshes, materials, mtl_dir: mtl_found })
+    Ok(ObjData { meshes, materials, mtl_dir: mtl_found, warnings })
+}
+
+/// tobj drops faces of fewer than 3 vertices without a word; so does raylab, but it says
+/// so, once, with the count, the first line, and whether the file looks truncated.
+fn short_faces_warning(path: &Path, text: &str) -> Option<String> {
+    let mut count = 0;
+    let mut first = 0;
+    for (i, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if words.next() == Some("f") && words.count() < 3 {
+            count += 1;
+            if count == 1 {
+                first = i + 1;
+            }
+        }
+    }
+    if count == 0 {
+        return None;
+    }
+    let truncated = if text.ends_with('\n') { "" } else { "; the last line has no end of line: is the file truncated?" };
+    let faces = if count == 1 { "face" } else { "faces" };
+    Some(format!("{}: skipped {count} {faces} with fewer than 3 vertices (the first on line {first}){truncated}", path.display()))
+}
+
+/// The MTL statements raylab uses, checked before tobj reads them (tobj takes `nan` and
+/// negative colours as given): colours finite and not negative, scalars finite.
+fn check_mtl(path: &Path, bytes: &[u8]) -> Result<(), LoadError> {
+    let text = String::from_utf8_lossy(bytes);
+    for (i, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let Some(kw) = words.next() else { continue };
+        let colour = matches!(kw, "Ka" | "Kd" | "Ks" | "Ke" | "Tf");
+        if !colour && !matches!(kw, "Ns" | "Ni" | "d" | "Tr") {
+            continue;
+        }
+        let rest: Vec<&str> = words.collect();
+        // Colours may be `spectral file` or `xyz x y z`, which raylab ignores as tobj does.
+        if rest.first().is_some_and(|w| w.parse::<f32>().is_err() && !w.eq_ignore_ascii_case("nan") && !w.to_ascii_lowercase().contains("inf")) {
+            continue;
+        }
+        let values: Vec<f32> = rest.iter().map_while(|w| w.parse::<f32>().ok()).collect();
+        let err = |m: &str| Err(LoadError::new(path, Some(i + 1), kw, format!("{m}, found `{}`", shorten(&rest.join(" ")))));
+        if values.iter().any(|v| !v.is_finite()) {
+            return err("expected finite numbers");
+        }
+        if (colour || kw == "Ns") && values.iter().any(|&v| v < 0.0) {
+            return err("must not be negative");
+        }
+    }
+    Ok(())
 }
 
 /// The line of the `k`-th (0-based) statement starting with `keyword`.
@@ -114,7 +186,7 @@ fn locate_error(path: &Path, text: &str, e: tobj::LoadError) -> LoadError {
                         continue;
                     }
                     let Ok(v) = idx.parse::<i64>() else {
-                        return LoadError::new(path, line_no, "", format!("bad face index `{corner}`"));
+                        return LoadError::new(path, line_no, "", format!("bad face index `{}`", shorten(corner)));
                     };
                     let (name, total) = totals[slot];
                     let ok = if v > 0 { v as usize <= total } else { v < 0 && (-v) as usize <= so_far[slot] };
@@ -125,7 +197,7 @@ fn locate_error(path: &Path, text: &str, e: tobj::LoadError) -> LoadError {
                 }
             }
         } else if rest.iter().take(3).any(|w| w.parse::<f32>().is_err()) || rest.len() < 2 {
-            return LoadError::new(path, line_no, "", format!("`{keyword}` expects numbers, found `{}`", rest.join(" ")));
+            return LoadError::new(path, line_no, "", format!("`{keyword}` expects numbers, found `{}`", shorten(&rest.join(" "))));
         }
     }
     LoadError::file(path, format!("cannot parse OBJ: {e}"))

@@ -14,7 +14,7 @@ use raylab_render::shape::bezier_patch::tessellate;
 use raylab_render::shape::BezierPatch;
 use raylab_render::TriangleMesh;
 
-use crate::error::{text_from_bytes, LoadError};
+use crate::error::{shorten, text_from_bytes, LoadError};
 use crate::files::Found;
 
 /// The patches of `found`, tessellated with `subdivisions` per patch side, in world space.
@@ -80,7 +80,7 @@ impl<'a> Lines<'a> {
         let (line, text) = self.next(field)?;
         match text.parse::<usize>() {
             Ok(n) if n > 0 => Ok(n),
-            _ => Err(LoadError::new(self.path, Some(line), field, format!("expected a whole number of at least 1, found `{text}`"))),
+            _ => Err(LoadError::new(self.path, Some(line), field, format!("expected a whole number of at least 1, found `{}`", shorten(text)))),
         }
     }
 
@@ -102,7 +102,7 @@ fn point(path: &Path, (line, text): (usize, &str), sep: char, field: &str) -> Re
     }
     let mut p = [0.0; 3];
     for (c, w) in p.iter_mut().zip(&words) {
-        *c = w.parse::<f32>().ok().filter(|x| x.is_finite()).ok_or_else(|| err(format!("`{w}` is not a finite number")))?;
+        *c = w.parse::<f32>().ok().filter(|x| x.is_finite()).ok_or_else(|| err(format!("`{}` is not a finite number", shorten(w))))?;
     }
     Ok(Vec3::from_array(p))
 }
@@ -119,7 +119,7 @@ fn parse_newell(path: &Path, text: &str) -> Result<Vec<BezierPatch>, LoadError> 
         if words.len() != 16 {
             return Err(LoadError::new(path, Some(line), field, format!("expected 16 comma-separated indices, found {}", words.len())));
         }
-        let indices = words.iter().map(|w| w.parse::<usize>().map_err(|_| LoadError::new(path, Some(line), &field, format!("`{w}` is not an index")))).collect::<Result<Vec<_>, _>>()?;
+        let indices = words.iter().map(|w| w.parse::<usize>().map_err(|_| LoadError::new(path, Some(line), &field, format!("`{}` is not an index", shorten(w))))).collect::<Result<Vec<_>, _>>()?;
         patches.push((line, field, indices));
     }
     let point_count = lines.count("point count")?;
@@ -152,7 +152,7 @@ fn parse_bpt(path: &Path, text: &str) -> Result<Vec<BezierPatch>, LoadError> {
         if degrees != ["3", "3"] {
             let msg = match degrees.iter().map(|d| d.parse::<u32>()).collect::<Result<Vec<_>, _>>() {
                 Ok(d) if d.len() == 2 => format!("degree {}×{} is not supported: only bicubic patches (`3 3`)", d[0], d[1]),
-                _ => format!("expected the degrees in u and v (`3 3`), found `{text}`"),
+                _ => format!("expected the degrees in u and v (`3 3`), found `{}`", shorten(text)),
             };
             return Err(LoadError::new(path, Some(line), field, msg));
         }

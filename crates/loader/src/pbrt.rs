@@ -535,6 +535,7 @@ impl Parser {
                     let to_light = self.ctm.inv;
                     let (w, h, texels) = crate::octahedral::to_equirect(w, &texels, |d| to_light.transform_vector3(d));
                     let image = ImageTexture::new(w, h, texels, Wrap::Repeat, Filter::Bilinear).map_err(|e| span.err(e.to_string()))?;
+                    EnvironmentLight::check_image(&image).map_err(|e| span.err(format!("{}: {e}", found.path().display())))?;
                     self.desc.environment = Some(EnvironmentLight::new(image, Rgb::splat(scale)));
                 }
                 None => self.desc.background = Background::Color(self.rgb(d, "L", Rgb::ONE)? * scale),

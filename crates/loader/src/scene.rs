@@ -91,6 +91,19 @@ pub fn parse_scene_str(src: &str, path: &Path, resolver: &Resolver) -> Result<Sc
     Ok(scene)
 }
 
+/// The largest camera distance whose square single precision holds (with a margin).
+const MAX_CAMERA_DISTANCE: f64 = 1e18;
+
+/// Why a `scale` step has no inverse: a zero factor, or a volume change beyond single
+/// precision (a scale of 1e13 cubes to 1e39).
+fn scale_error(v: &Val, f: Vec3) -> LoadError {
+    if f.cmpeq(Vec3::ZERO).any() {
+        return v.err("scale must not be zero");
+    }
+    let det = f.x as f64 * f.y as f64 * f.z as f64;
+    v.err(format!("scale [{:e}, {:e}, {:e}] changes volumes by {det:.1e}, beyond single precision (1e-30 to 3.4e38 in magnitude)", f.x, f.y, f.z))
+}
+
 struct Builder<'a> {
     doc: &'a Doc<'a>,
     resolver: &'a Resolver,
@@ -148,6 +161,12 @@ impl Builder<'_> {
             return Err(c.get("aperture").unwrap().err(format!("must not be negative, found {aperture}")));
         }
         let focus_distance = c.opt("focus_distance", |v| positive(v, v.f32()?))?;
+        // Single precision squares the distance to aim the camera: beyond ~1e19 that
+        // overflows, and Camera::new would wrongly say that `at` equals `from`.
+        let distance = from.as_dvec3().distance(at.as_dvec3());
+        if distance > MAX_CAMERA_DISTANCE {
+            return Err(at_v.err(format!("is {distance:.1e} from camera.from, farther than single precision can aim a camera ({MAX_CAMERA_DISTANCE:e})")));
+        }
         let at_span = self.span(&at_v);
         let up_span = up_v.as_ref().map_or_else(|| at_span.clone(), |v| self.span(v));
         Ok(CameraDescription { from, at, up, vfov, aperture, focus_distance, at_span, up_span })
@@ -409,7 +428,7 @@ impl Builder<'_> {
                         Ok(a) => Vec3::from_array(a),
                         Err(_) => Vec3::splat(s.f32().map_err(|_| s.err("expected a number or an array of 3 numbers"))?),
                     };
-                    Transform::scale(f).ok_or_else(|| s.err("scale must not be zero"))?
+                    Transform::scale(f).ok_or_else(|| scale_error(&s, f))?
                 }
                 "rotate" => {
                     let r = st.get("rotate").unwrap().table(ROTATE)?;
@@ -511,6 +530,7 @@ impl Builder<'_> {
                 let smooth = t.opt("smooth", |v| v.bool())?.unwrap_or(false);
                 let crease = t.opt("crease_angle", |v| if smooth { in_range_f32(v, v.f32()?, 0.0, 180.0) } else { Err(v.err("needs `smooth = true`")) })?.unwrap_or(180.0);
                 let obj = load_mesh_file(&found, &to_world)?;
+                scene.warnings.extend(obj.warnings.iter().cloned());
                 for (mut mesh, mtl) in obj.meshes {
                     if let Some(ke) = mtl.and_then(|k| obj.materials.get(k)).and_then(|m| m.emissive) {
                         mesh.emission = mtl_color(Some(ke), Rgb::ZERO);
@@ -632,6 +652,7 @@ impl Builder<'_> {
         let fv = t.req("file")?;
         let found = self.find(&fv)?;
         let image = self.image_texture(&fv, &found, true, Wrap::Repeat, Filter::Bilinear)?;
+        EnvironmentLight::check_image(&image).map_err(|e| fv.err(format!("{}: {e}", found.path().display())))?;
         scene.environment = Some(EnvironmentLight::new(image, scale));
         Ok(())
     }

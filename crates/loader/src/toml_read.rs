@@ -9,7 +9,7 @@ use raylab_core::{Rgb, Vec2, Vec3};
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
-use crate::error::LoadError;
+use crate::error::{shorten, LoadError};
 
 /// A parsed document and what is needed to turn byte offsets into lines.
 pub struct Doc<'s> {
@@ -238,7 +238,7 @@ impl<'a, 'i> Table<'a, 'i> {
         if valid.contains(&s) {
             Ok(s)
         } else {
-            Err(v.err(format!("unknown type `{s}` (valid: {})", valid.join(", "))))
+            Err(v.err(format!("unknown type `{}` (valid: {})", shorten(s), valid.join(", "))))
         }
     }
 }

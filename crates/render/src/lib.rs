@@ -9,6 +9,7 @@ pub mod film;
 pub mod integrator;
 pub mod light;
 pub mod material;
+pub mod memory_guard;
 pub mod render;
 pub mod sampler;
 pub mod scene;

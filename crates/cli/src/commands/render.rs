@@ -303,7 +303,13 @@ pub fn run(a: &RenderArgs) -> Result<()> {
                 }
                 f
             }
-            None => Film::new(header.clone(), crop)?,
+            None => {
+                // A film's sums (CHANNELS f64 per pixel, twice while passes merge) and the
+                // resolved image: refused before allocating when it cannot fit.
+                let bytes = (crop.pixels() as u64).checked_mul(2 * raylab_render::film::CHANNELS as u64 * 8 + 16);
+                raylab_render::memory_guard::check(&format!("a {}×{} film", crop.width(), crop.height()), bytes).map_err(|e| anyhow!("{e}"))?;
+                Film::new(header.clone(), crop)?
+            }
         };
         let first_pass = if film.passes().is_empty() { header.passes_of(&samples)?.start } else { film.passes().end };
         let passes_left = header.passes_of(&samples)?.end.saturating_sub(first_pass);

@@ -56,6 +56,20 @@ impl EnvironmentLight {
         Self { distribution: Distribution2D::new(&weights, w, h), image, scale }
     }
 
+    /// Why `image` cannot be an environment map, if it cannot: it gives radiance, which is
+    /// never negative (an HDR file may hold negative values, which would render as
+    /// negative pixels) and always finite.
+    pub fn check_image(image: &ImageTexture) -> Result<(), String> {
+        let w = image.width() as usize;
+        match image.texels().iter().position(|t| !t.is_finite() || t.min_element() < 0.0) {
+            Some(i) => {
+                let t = image.texels()[i];
+                Err(format!("texel ({}, {}) is [{}, {}, {}]: an environment map's radiance must be finite and not negative", i % w, i / w, t.x, t.y, t.z))
+            }
+            None => Ok(()),
+        }
+    }
+
     /// Radiance arriving from direction `dir` (any length).
     pub fn radiance(&self, dir: Vec3) -> Rgb {
         self.image.lookup(equirect_uv(dir)) * self.scale
