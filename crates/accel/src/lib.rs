@@ -35,7 +35,7 @@ pub use kdtree::KdTree;
 pub use primitives::{Hit, PrimHit, Primitives};
 pub use sphere_bvh::SphereBvh;
 pub use stats::AccelStats;
-pub use wide::{Kernel, WideBvh};
+pub use wide::{Kernel, WideBvh, PACKET};
 
 /// What every acceleration structure offers.
 pub trait Accel: Send + Sync {
@@ -262,6 +262,25 @@ impl AnyAccel {
             AnyAccel::Bvh8(a) => a.occluded_fast(prims, ray),
             AnyAccel::Bvh4(a) => a.occluded_fast(prims, ray),
             a => a.occluded(prims, ray, &mut Counters::default()),
+        }
+    }
+
+    /// Closest hits of a packet of at most [`PACKET`] rays (a 4×4 tile of camera rays):
+    /// wide BVHs traverse the rays together, other structures one by one. `out[i]` is
+    /// exactly [`AnyAccel::intersect_fast`] of `rays[i]`.
+    ///
+    /// # Panics
+    /// If `rays` holds more than [`PACKET`] rays or `out` is not as long as `rays`.
+    pub fn intersect_packet<P: Primitives + ?Sized>(&self, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
+        assert!(rays.len() <= PACKET && out.len() == rays.len(), "a packet holds at most {PACKET} rays and as many answers");
+        match self {
+            AnyAccel::Bvh8(a) => a.intersect_packet(prims, rays, out),
+            AnyAccel::Bvh4(a) => a.intersect_packet(prims, rays, out),
+            a => {
+                for (o, r) in out.iter_mut().zip(rays) {
+                    *o = a.intersect_fast(prims, r);
+                }
+            }
         }
     }
 
