@@ -215,3 +215,34 @@ fn packet_edge_cases() {
     assert_eq!(one[0].map(|h| h.t), Some(1.5), "the face z = -0.5 from z = -2");
     accel.intersect_packet(&cube, &[], &mut []);
 }
+
+/// `--build-quality` picks the builder under `bvh`, `bvh4` and `bvh8`: PLOC, binned SAH or
+/// SBVH, the same trees as the structures of those names; every layout answers as the
+/// oracle does.
+#[test]
+fn build_quality_picks_the_builder() {
+    use raylab_accel::BuildQuality;
+    let soup = kit::read_obj_triangles(&kit::shared_scenes().join("bunny_4968.obj"));
+    let b = soup.bounds();
+    let mut rng = Pcg32::new(26, 1);
+    let rays = kit::random_rays(&mut rng, 500, &Aabb::new(b.min - b.extent(), b.max + b.extent()), &b);
+    let oracle = AnyAccel::build(AccelKind::None, &soup, &BuildOptions::default());
+    let stats = |kind, opts: &BuildOptions| {
+        let s = AnyAccel::build(kind, &soup, opts).stats();
+        (s.interior_nodes, s.leaves, s.references, s.max_depth, s.sah_cost.to_bits())
+    };
+    for (quality, same_as) in [(BuildQuality::Low, AccelKind::LbvhPloc), (BuildQuality::Medium, AccelKind::Bvh), (BuildQuality::High, AccelKind::Sbvh)] {
+        let opts = BuildOptions { quality, ..Default::default() };
+        assert_eq!(stats(AccelKind::Bvh, &opts), stats(same_as, &BuildOptions::default()), "{quality}: bvh is {same_as}'s tree");
+        for kind in [AccelKind::Bvh, AccelKind::Bvh4, AccelKind::Bvh8] {
+            let accel = AnyAccel::build(kind, &soup, &opts);
+            accel.validate(&soup).unwrap_or_else(|e| panic!("{quality}/{kind}: {e}"));
+            assert_eq!(accel.stats().name, kind.name());
+            let mut c = Counters::default();
+            for (k, ray) in rays.iter().enumerate() {
+                kit::agrees_with_oracle(&soup, ray, oracle.intersect(&soup, ray, &mut c), accel.intersect(&soup, ray, &mut c)).unwrap_or_else(|e| panic!("{quality}/{kind} ray {k}: {e}"));
+            }
+        }
+    }
+    assert_eq!("ultra".parse::<BuildQuality>().unwrap_err(), "unknown build quality `ultra` (valid: low, medium, high)");
+}

@@ -206,7 +206,7 @@ fn generated_scenes_have_the_expected_size() {
 fn help_explains_every_render_option() {
     let o = raylab(&["render", "--help"], Path::new("."));
     let help = String::from_utf8_lossy(&o.stdout);
-    for option in ["--width", "--height", "--spp", "--threads", "--seed", "--accel", "--output", "--tonemap", "--exposure", "--integrator", "--sampler"] {
+    for option in ["--width", "--height", "--spp", "--threads", "--seed", "--accel", "--build-quality", "--output", "--tonemap", "--exposure", "--integrator", "--sampler"] {
         assert!(help.contains(option), "render --help lacks {option}");
     }
 }

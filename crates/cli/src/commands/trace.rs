@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use raylab_accel::{AccelKind, AnyAccel, BuildOptions};
+use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, BuildQuality};
 use raylab_loader::Overrides;
 
 #[derive(Args, Clone, Debug)]
@@ -19,6 +19,9 @@ pub struct TraceArgs {
     /// Acceleration structure
     #[arg(long, default_value = "bvh")]
     pub accel: String,
+    /// Builder under bvh, bvh4 and bvh8: low (PLOC), medium (binned SAH), high (SBVH)
+    #[arg(long, default_value = "medium", value_parser = |s: &str| s.parse::<BuildQuality>())]
+    pub build_quality: BuildQuality,
     /// Any-hit (shadow) queries instead of closest hits
     #[arg(long)]
     pub any_hit: bool,
@@ -51,7 +54,8 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     let pool = b.build()?;
     pool.install(|| -> Result<()> {
         let scene = raylab_loader::load_scene_or_mesh(&a.scene, &Overrides { accel: Some(AccelKind::None), ..Default::default() })?;
-        let accel = AnyAccel::build(kind, &scene.geometry, &BuildOptions::default());
+        let accel = AnyAccel::build(kind, &scene.geometry, &BuildOptions { quality: a.build_quality, ..Default::default() });
+        let build_ms = accel.stats().build_ms;
         let mut results = Vec::new();
         for _ in 0..=a.repeats {
             // Nothing here prints counters: the fast path, with counting compiled out.
@@ -68,7 +72,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
         if a.json {
             println!(
                 "{}",
-                serde_json::json!({ "rays": r.count, "hits": r.hits, "t_sum": r.t_sum, "seconds": seconds, "mrays_per_s": mrays, "accel": kind.name(), "any_hit": a.any_hit, "packet": a.packet.unwrap_or(1), "threads": rayon::current_num_threads() })
+                serde_json::json!({ "rays": r.count, "hits": r.hits, "t_sum": r.t_sum, "seconds": seconds, "mrays_per_s": mrays, "accel": kind.name(), "build_quality": a.build_quality.name(), "build_ms": build_ms, "any_hit": a.any_hit, "packet": a.packet.unwrap_or(1), "threads": rayon::current_num_threads() })
             );
         } else {
             let query = match a.packet {
@@ -76,7 +80,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
                 None if a.any_hit => "any hit".into(),
                 None => "closest hit".into(),
             };
-            println!("rays {}  hits {}  t_sum {:.6}  {:.2} Mrays/s ({}, {}, median of {} on {} threads)", r.count, r.hits, r.t_sum, mrays, kind, query, a.repeats, rayon::current_num_threads());
+            println!("rays {}  hits {}  t_sum {:.6}  {:.2} Mrays/s ({}, {}, median of {} on {} threads; built in {build_ms:.1} ms at {} quality)", r.count, r.hits, r.t_sum, mrays, kind, query, a.repeats, rayon::current_num_threads(), a.build_quality);
         }
         Ok(())
     })
