@@ -14,8 +14,10 @@ use std::mem::MaybeUninit;
 use raylab_core::intersect::ShearedRay;
 use raylab_core::Ray;
 
+#[cfg(target_arch = "x86_64")]
+use super::kernels::slabs_avx2;
 use super::kernels::{RayBoxes, ROBUST_FAR};
-use super::node::{is_leaf, ChildRef, TriBlock, EMPTY};
+use super::node::{is_leaf, ChildRef, TriBlock, WideNode, EMPTY};
 use super::traverse::{candidates, child_boxes, leaf_slice, wins, STACK};
 use super::WideBvh;
 use crate::{Hit, PrimHit, Primitives};
@@ -44,6 +46,63 @@ fn bits(mut m: u32) -> impl Iterator<Item = usize> {
             b
         })
     })
+}
+
+/// Tests the children of `node` against the `active` rays: `entered[l]` gets the rays
+/// entering child `l`, `nearest[l]` their least entry distance; returns the children
+/// entered by any ray.
+#[inline(always)]
+fn node_boxes<const W: usize, const SIMD: bool>(node: &WideNode<W>, rb: &[RayBoxes; PACKET], far: &[f32; PACKET], active: RayMask, entered: &mut [RayMask; W], nearest: &mut [f32; W]) -> u32 {
+    #[cfg(target_arch = "x86_64")]
+    if SIMD && W == 8 {
+        // SAFETY: `W == 8`, so these are the same types; SIMD = true with W = 8 is only
+        // instantiated inside `#[target_feature(enable = "avx2")]` functions that the
+        // build selects after `is_x86_feature_detected!("avx2")`.
+        return unsafe {
+            node_boxes_avx2(&*(node as *const WideNode<W>).cast::<WideNode<8>>(), rb, far, active, &mut *(entered as *mut [RayMask; W]).cast::<[RayMask; 8]>(), &mut *(nearest as *mut [f32; W]).cast::<[f32; 8]>())
+        };
+    }
+    let mut any = 0u32;
+    for r in bits(active) {
+        let mut tnear = [0.0f32; W];
+        let m = child_boxes::<W, SIMD>(node, &rb[r], far[r], &mut tnear);
+        any |= m;
+        for l in bits(m) {
+            entered[l] |= 1 << r;
+            nearest[l] = nearest[l].min(tnear[l]);
+        }
+    }
+    any
+}
+
+/// [`node_boxes`] for 8-wide nodes with AVX2: each ray's slab test as in single-ray
+/// traversal ([`slabs_avx2`]), its hit lanes or-ed into the children's ray masks and its
+/// entry distances min-ed into theirs in registers, with no per-lane loop.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[inline]
+#[target_feature(enable = "avx2")]
+unsafe fn node_boxes_avx2(node: &WideNode<8>, rb: &[RayBoxes; PACKET], far: &[f32; PACKET], active: RayMask, entered: &mut [RayMask; 8], nearest: &mut [f32; 8]) -> u32 {
+    use std::arch::x86_64::*;
+    let mut rays = _mm256_setzero_si256();
+    let mut near = _mm256_set1_ps(f32::INFINITY);
+    for r in bits(active) {
+        // SAFETY: AVX2 is enabled in this function.
+        let (t0, t1) = unsafe { slabs_avx2(node, &rb[r], far[r]) };
+        let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1);
+        rays = _mm256_or_si256(rays, _mm256_and_si256(_mm256_castps_si256(hit), _mm256_set1_epi32(1 << r)));
+        // Entry distances are never NaN (the slab test's `max` keeps `t_min` over a NaN).
+        near = _mm256_min_ps(near, _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), t0, hit));
+    }
+    // SAFETY: both arrays hold 8 lanes of 4 bytes.
+    unsafe {
+        _mm256_storeu_si256(entered.as_mut_ptr().cast(), rays);
+        _mm256_storeu_ps(nearest.as_mut_ptr(), near);
+    }
+    // Ray masks are below 2^16, so "non-zero" is "greater than zero".
+    _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(rays, _mm256_setzero_si256()))) as u32
 }
 
 /// Closest hits of `rays` (at most [`PACKET`]) into `out` (as long as `rays`).
@@ -96,16 +155,7 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, const SIMD: bool>(
             // Per child: the rays entering it and their least entry distance.
             let mut entered = [0 as RayMask; W];
             let mut nearest = [f32::INFINITY; W];
-            let mut any = 0u32;
-            for r in bits(active) {
-                let mut tnear = [0.0f32; W];
-                let m = child_boxes::<W, SIMD>(node, &rb[r], far[r], &mut tnear);
-                any |= m;
-                for l in bits(m) {
-                    entered[l] |= 1 << r;
-                    nearest[l] = nearest[l].min(tnear[l]);
-                }
-            }
+            let any = node_boxes::<W, SIMD>(node, &rb, &far, active, &mut entered, &mut nearest);
             if any != 0 {
                 if any & (any - 1) == 0 {
                     let l = any.trailing_zeros() as usize;
