@@ -147,7 +147,8 @@ impl FromStr for AccelKind {
 /// `bvh8` are laid out from (other names keep their own builder).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum BuildQuality {
-    /// PLOC (Meister & Bittner 2018): the fastest build, a slightly worse tree.
+    /// LBVH (Morton codes, Karras 2012), as Embree's low quality: the fastest build
+    /// (2-5x faster than binned SAH here), a worse tree.
     Low,
     /// Binned SAH (Wald 2007): the default.
     #[default]
@@ -215,7 +216,7 @@ pub(crate) fn robust_margin(scene: &Aabb) -> f32 {
 /// The binary BVH of `opts.quality`, named `name` (the user's choice, whatever the builder).
 fn binary_at_quality<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions, name: &'static str) -> Bvh {
     let mut bvh = match opts.quality {
-        BuildQuality::Low => bvh::ploc::build(prims, opts),
+        BuildQuality::Low => bvh::lbvh::build(prims, opts),
         BuildQuality::Medium => Bvh::build(prims, SplitMethod::BinnedSah, opts),
         BuildQuality::High => bvh::sbvh::build(prims, opts),
     };

@@ -216,7 +216,7 @@ fn packet_edge_cases() {
     accel.intersect_packet(&cube, &[], &mut []);
 }
 
-/// `--build-quality` picks the builder under `bvh`, `bvh4` and `bvh8`: PLOC, binned SAH or
+/// `--build-quality` picks the builder under `bvh`, `bvh4` and `bvh8`: LBVH, binned SAH or
 /// SBVH, the same trees as the structures of those names; every layout answers as the
 /// oracle does.
 #[test]
@@ -231,7 +231,7 @@ fn build_quality_picks_the_builder() {
         let s = AnyAccel::build(kind, &soup, opts).stats();
         (s.interior_nodes, s.leaves, s.references, s.max_depth, s.sah_cost.to_bits())
     };
-    for (quality, same_as) in [(BuildQuality::Low, AccelKind::LbvhPloc), (BuildQuality::Medium, AccelKind::Bvh), (BuildQuality::High, AccelKind::Sbvh)] {
+    for (quality, same_as) in [(BuildQuality::Low, AccelKind::Lbvh), (BuildQuality::Medium, AccelKind::Bvh), (BuildQuality::High, AccelKind::Sbvh)] {
         let opts = BuildOptions { quality, ..Default::default() };
         assert_eq!(stats(AccelKind::Bvh, &opts), stats(same_as, &BuildOptions::default()), "{quality}: bvh is {same_as}'s tree");
         for kind in [AccelKind::Bvh, AccelKind::Bvh4, AccelKind::Bvh8] {

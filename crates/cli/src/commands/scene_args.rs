@@ -64,7 +64,7 @@ pub struct SettingsArgs {
     /// Bins of the binned SAH builders (default 16)
     #[arg(long, value_parser = clap::value_parser!(u32).range(2..=1024))]
     pub bins: Option<u32>,
-    /// Builder under bvh, bvh4 and bvh8, as Embree's quality: low (PLOC, fastest build), medium (binned SAH, the default), high (SBVH with spatial splits, best tree); see docs/performance.md
+    /// Builder under bvh, bvh4 and bvh8, as Embree's quality: low (LBVH, fastest build), medium (binned SAH, the default), high (SBVH with spatial splits, best tree); see docs/performance.md
     #[arg(long, value_parser = named!(raylab_accel::BuildQuality))]
     pub build_quality: Option<raylab_accel::BuildQuality>,
     /// Pixel reconstruction filter

@@ -19,7 +19,7 @@ pub struct TraceArgs {
     /// Acceleration structure
     #[arg(long, default_value = "bvh")]
     pub accel: String,
-    /// Builder under bvh, bvh4 and bvh8: low (PLOC), medium (binned SAH), high (SBVH)
+    /// Builder under bvh, bvh4 and bvh8: low (LBVH), medium (binned SAH), high (SBVH)
     #[arg(long, default_value = "medium", value_parser = |s: &str| s.parse::<BuildQuality>())]
     pub build_quality: BuildQuality,
     /// Any-hit (shadow) queries instead of closest hits
