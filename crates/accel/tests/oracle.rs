@@ -2,7 +2,7 @@
 //! primitive and distance for closest hits, the same answer for any-hit queries.
 
 use proptest::prelude::*;
-use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Primitives};
+use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Primitives, PACKET};
 use raylab_core::{Aabb, Pcg32, Ray, Vec3};
 use raylab_testkit::{self as kit, Prim, Soup};
 
@@ -21,6 +21,19 @@ fn check_all(name: &str, soup: &Soup, rays: &[Ray]) {
             assert_eq!(accel.occluded(soup, ray, &mut c), want.is_some(), "{name}/{kind} ray {k}: any hit");
             let short = Ray { t_max: want.map_or(1.0, |h| h.t * 0.5), ..*ray };
             assert_eq!(accel.occluded(soup, &short, &mut c), oracle.occluded(soup, &short, &mut c), "{name}/{kind} ray {k}: short any hit");
+        }
+        check_packets(name, kind, &accel, soup, rays);
+    }
+}
+
+/// Packets of 16 consecutive rays (and a shorter last one) give exactly the single-ray
+/// answers, which the loop above checked against the oracle.
+fn check_packets(name: &str, kind: AccelKind, accel: &AnyAccel, soup: &Soup, rays: &[Ray]) {
+    for (p, packet) in rays.chunks(PACKET).enumerate() {
+        let mut out = vec![None; packet.len()];
+        accel.intersect_packet(soup, packet, &mut out);
+        for (i, ray) in packet.iter().enumerate() {
+            assert_eq!(out[i], accel.intersect_fast(soup, ray), "{name}/{kind} packet {p} ray {i}");
         }
     }
 }

@@ -2,7 +2,7 @@
 //! distance and barycentrics), the counting and fast paths agree, and the layouts hold
 //! the triangles they were built from.
 
-use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Kernel, Primitives};
+use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Kernel, Primitives, PACKET};
 use raylab_core::{Aabb, Pcg32, Ray, Vec3};
 use raylab_testkit::{self as kit, Soup};
 
@@ -124,4 +124,125 @@ fn oversized_binary_leaf_is_split() {
             assert_eq!(wide.intersect(&soup, &ray, &mut c).map(|h| h.t), oracle.intersect(&soup, &ray, &mut c).map(|h| h.t));
         }
     }
+}
+
+/// `rays` in packets of 16 through every wide layout and both kernels: each answer is
+/// exactly the single-ray one (same primitive, distance and barycentrics).
+fn check_packets_match_single(name: &str, soup: &Soup, rays: &[Ray]) -> usize {
+    let mut hits = 0;
+    for kind in WIDE {
+        let simd = AnyAccel::build(kind, soup, &BuildOptions::default()).with_kernel(Kernel::Simd);
+        let portable = AnyAccel::build(kind, soup, &BuildOptions::default()).with_kernel(Kernel::Portable);
+        for (p, packet) in rays.chunks(PACKET).enumerate() {
+            let (mut s, mut q) = (vec![None; packet.len()], vec![None; packet.len()]);
+            simd.intersect_packet(soup, packet, &mut s);
+            portable.intersect_packet(soup, packet, &mut q);
+            for (i, ray) in packet.iter().enumerate() {
+                let single = simd.intersect_fast(soup, ray);
+                assert_eq!(s[i], single, "{name}/{kind} packet {p} ray {i}: SIMD packet vs single ray");
+                assert_eq!(q[i], single, "{name}/{kind} packet {p} ray {i}: portable packet vs single ray");
+                hits += usize::from(single.is_some());
+            }
+        }
+    }
+    hits
+}
+
+/// Camera rays in 4×4 tiles, as the ray files order them: `n × n` pixels of a pinhole
+/// camera at `eye` looking at `target` with a field of view of `fov` radians.
+fn camera_tiles(eye: Vec3, target: Vec3, fov: f32, n: usize) -> Vec<Ray> {
+    let f = (target - eye).normalize();
+    let r = f.cross(Vec3::Y).normalize();
+    let u = r.cross(f);
+    let half = (fov * 0.5).tan();
+    let mut rays = Vec::new();
+    for ty in (0..n).step_by(4) {
+        for tx in (0..n).step_by(4) {
+            for y in ty..ty + 4 {
+                for x in tx..tx + 4 {
+                    let sx = ((x as f32 + 0.5) / n as f32 * 2.0 - 1.0) * half;
+                    let sy = ((y as f32 + 0.5) / n as f32 * 2.0 - 1.0) * half;
+                    rays.push(Ray::new(eye, (f + sx * r + sy * u).normalize()));
+                }
+            }
+        }
+    }
+    rays
+}
+
+#[test]
+fn packets_answer_as_single_rays_coherent_and_incoherent() {
+    let bunny = kit::read_obj_triangles(&kit::shared_scenes().join("bunny_4968.obj"));
+    let b = bunny.bounds();
+    let centre = 0.5 * (b.min + b.max);
+    // Coherent tiles framing the bunny with margin: many rays miss.
+    let eye = centre + Vec3::new(0.3, 0.2, 2.5) * b.extent().max_element();
+    let tiles = camera_tiles(eye, centre, 0.6, 64);
+    let hits = check_packets_match_single("bunny tiles", &bunny, &tiles);
+    assert!(hits > 3 * 1000 && hits < 3 * 64 * 64, "tiles should both hit and miss: {hits} hits");
+    // Incoherent packets: random origins and directions, and a packet of rays that all miss.
+    let mut rng = Pcg32::new(25, 1);
+    let mut rays = kit::random_rays(&mut rng, 1600, &Aabb::new(b.min - b.extent(), b.max + b.extent()), &b);
+    rays.extend((0..16).map(|k| Ray::new(b.max + Vec3::splat(1.0 + k as f32), Vec3::ONE.normalize())));
+    // A short last packet.
+    rays.truncate(rays.len() - 5);
+    check_packets_match_single("bunny random", &bunny, &rays);
+    // Ties: rays from inside the cube at its shared edges and corners hit two or three
+    // triangles at the same distance; packets pick the same one as single rays.
+    let corners: Vec<Vec3> = (0..8).map(|k| Vec3::new((k & 1) as f32, ((k >> 1) & 1) as f32, ((k >> 2) & 1) as f32) - 0.5).collect();
+    let mut ties = Vec::new();
+    for _ in 0..800 {
+        let o = kit::random_point(&mut rng, &Aabb::new(Vec3::splat(-0.4), Vec3::splat(0.4)));
+        let (a, c) = (corners[rng.below(8) as usize], corners[rng.below(8) as usize]);
+        ties.push(Ray::new(o, (0.5 * (a + c) - o).try_normalize().unwrap_or(Vec3::X)));
+    }
+    let cube = kit::cube();
+    assert_eq!(check_packets_match_single("cube edges", &cube, &ties), 3 * ties.len(), "every ray from inside hits");
+}
+
+/// Packets in an empty scene, of one ray, and of no rays.
+#[test]
+fn packet_edge_cases() {
+    let soup = Soup::default();
+    let accel = AnyAccel::build(AccelKind::Bvh8, &soup, &BuildOptions::default());
+    let mut out = vec![Some(raylab_accel::Hit { t: 1.0, prim: 0, u: 0.0, v: 0.0 }); 3];
+    accel.intersect_packet(&soup, &[Ray::new(Vec3::ZERO, Vec3::X); 3], &mut out);
+    assert_eq!(out, vec![None; 3], "an empty scene: no hits, old answers cleared");
+    let cube = kit::cube();
+    let accel = AnyAccel::build(AccelKind::Bvh8, &cube, &BuildOptions::default());
+    let mut one = [None];
+    accel.intersect_packet(&cube, &[Ray::new(Vec3::new(0.0, 0.0, -2.0), Vec3::Z)], &mut one);
+    assert_eq!(one[0].map(|h| h.t), Some(1.5), "the face z = -0.5 from z = -2");
+    accel.intersect_packet(&cube, &[], &mut []);
+}
+
+/// `--build-quality` picks the builder under `bvh`, `bvh4` and `bvh8`: LBVH, binned SAH or
+/// SBVH, the same trees as the structures of those names; every layout answers as the
+/// oracle does.
+#[test]
+fn build_quality_picks_the_builder() {
+    use raylab_accel::BuildQuality;
+    let soup = kit::read_obj_triangles(&kit::shared_scenes().join("bunny_4968.obj"));
+    let b = soup.bounds();
+    let mut rng = Pcg32::new(26, 1);
+    let rays = kit::random_rays(&mut rng, 500, &Aabb::new(b.min - b.extent(), b.max + b.extent()), &b);
+    let oracle = AnyAccel::build(AccelKind::None, &soup, &BuildOptions::default());
+    let stats = |kind, opts: &BuildOptions| {
+        let s = AnyAccel::build(kind, &soup, opts).stats();
+        (s.interior_nodes, s.leaves, s.references, s.max_depth, s.sah_cost.to_bits())
+    };
+    for (quality, same_as) in [(BuildQuality::Low, AccelKind::Lbvh), (BuildQuality::Medium, AccelKind::Bvh), (BuildQuality::High, AccelKind::Sbvh)] {
+        let opts = BuildOptions { quality, ..Default::default() };
+        assert_eq!(stats(AccelKind::Bvh, &opts), stats(same_as, &BuildOptions::default()), "{quality}: bvh is {same_as}'s tree");
+        for kind in [AccelKind::Bvh, AccelKind::Bvh4, AccelKind::Bvh8] {
+            let accel = AnyAccel::build(kind, &soup, &opts);
+            accel.validate(&soup).unwrap_or_else(|e| panic!("{quality}/{kind}: {e}"));
+            assert_eq!(accel.stats().name, kind.name());
+            let mut c = Counters::default();
+            for (k, ray) in rays.iter().enumerate() {
+                kit::agrees_with_oracle(&soup, ray, oracle.intersect(&soup, ray, &mut c), accel.intersect(&soup, ray, &mut c)).unwrap_or_else(|e| panic!("{quality}/{kind} ray {k}: {e}"));
+            }
+        }
+    }
+    assert_eq!("ultra".parse::<BuildQuality>().unwrap_err(), "unknown build quality `ultra` (valid: low, medium, high)");
 }

@@ -174,6 +174,12 @@ fn bench_agrees_with_the_oracle_and_trace_reproduces_it() {
     assert_eq!(t["hits"], oracle["hits"]);
     assert_eq!(t["t_sum"], oracle["t_sum"]);
     assert_eq!(t["rays"], oracle["count"]);
+    // Packets of 16 (4×4 tiles of the dumped primary rays) give the same answers.
+    let o = raylab(&["trace", cube.to_str().unwrap(), "--rays", "rays/cube-primary.rays", "--accel", "bvh8", "--packet", "16", "--json"], &dir);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let t: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!((&t["hits"], &t["t_sum"], &t["packet"]), (&oracle["hits"], &oracle["t_sum"], &serde_json::json!(16)));
+    fails_with(&["trace", cube.to_str().unwrap(), "--rays", "rays/cube-primary.rays", "--packet", "16", "--any-hit"], &dir, "--packet traces closest hits only: drop --any-hit or --packet");
 }
 
 #[test]
@@ -200,7 +206,7 @@ fn generated_scenes_have_the_expected_size() {
 fn help_explains_every_render_option() {
     let o = raylab(&["render", "--help"], Path::new("."));
     let help = String::from_utf8_lossy(&o.stdout);
-    for option in ["--width", "--height", "--spp", "--threads", "--seed", "--accel", "--output", "--tonemap", "--exposure", "--integrator", "--sampler"] {
+    for option in ["--width", "--height", "--spp", "--threads", "--seed", "--accel", "--build-quality", "--output", "--tonemap", "--exposure", "--integrator", "--sampler"] {
         assert!(help.contains(option), "render --help lacks {option}");
     }
 }

@@ -97,6 +97,38 @@ pub fn trace_counting<P: Primitives + ?Sized>(accel: &AnyAccel, prims: &P, rays:
     out
 }
 
+/// Closest hits of `rays` traced in packets of `packet` consecutive rays (at most
+/// [`raylab_accel::PACKET`]; ray files hold primary rays in 4×4 tiles, so 16 is a tile),
+/// without counting. The answers, hence `hits` and `t_sum`, are those of
+/// [`trace_counting`]: chunks and sums are the same.
+pub fn trace_packets<P: Primitives + ?Sized>(accel: &AnyAccel, prims: &P, rays: &[Ray], packet: usize) -> TraceResult {
+    assert!((1..=raylab_accel::PACKET).contains(&packet), "packets of 1 to {} rays", raylab_accel::PACKET);
+    let start = Instant::now();
+    let parts: Vec<(u64, f64)> = rays
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            let (mut hits, mut t_sum) = (0u64, 0.0f64);
+            let mut out = [None; raylab_accel::PACKET];
+            for p in chunk.chunks(packet) {
+                accel.intersect_packet(prims, p, &mut out[..p.len()]);
+                for h in out[..p.len()].iter().flatten() {
+                    hits += 1;
+                    t_sum += h.t as f64;
+                }
+            }
+            (hits, t_sum)
+        })
+        .collect();
+    let seconds = start.elapsed().as_secs_f64();
+    let mut out = TraceResult { count: rays.len() as u64, seconds, ..Default::default() };
+    out.counters.rays = out.count;
+    for (h, t) in parts {
+        out.hits += h;
+        out.t_sum += t;
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -141,6 +173,12 @@ mod tests {
                 let counted = trace(&accel, &floor, &rays, any_hit);
                 let fast = trace_counting(&accel, &floor, &rays, any_hit, false);
                 assert!(counted.agrees_with(&fast), "{kind}: {counted:?} vs {fast:?}");
+                if !any_hit {
+                    for packet in [1, 7, 16] {
+                        let packets = trace_packets(&accel, &floor, &rays, packet);
+                        assert!(packets.agrees_with(&fast), "{kind}, packets of {packet}: {packets:?} vs {fast:?}");
+                    }
+                }
                 assert!(counted.counters.nodes_visited > 0);
                 assert_eq!(fast.counters.rays, rays.len() as u64);
                 let inside = rays.iter().filter(|r| (0.0..=20.0).contains(&r.origin.x) && (0.0..=20.0).contains(&r.origin.y)).count() as u64;

@@ -58,7 +58,7 @@ fn flatten(node: BuildNode, slot: usize, nodes: &mut Vec<BvhNode>) {
 impl Ctx<'_> {
     /// Builds the subtree over `idx`, whose first element sits at `offset` in the index array.
     fn build(&self, idx: &mut [u32], offset: usize, depth: usize) -> BuildNode {
-        let bounds = idx.iter().fold(Aabb::EMPTY, |b, &i| b.union(self.bounds[i as usize]));
+        let bounds = self.union_of(idx, |i| self.bounds[i as usize]);
         let leaf = BuildNode::Leaf { bounds, first: offset as u32, count: idx.len() as u32 };
         if idx.len() <= 1 || depth >= MAX_DEPTH {
             return leaf;
@@ -75,7 +75,7 @@ impl Ctx<'_> {
 
     /// Partitions `idx` and returns the size of the left part, or `None` for a leaf.
     fn split(&self, idx: &mut [u32], bounds: &Aabb) -> Option<usize> {
-        let cb = Aabb::from_points(idx.iter().map(|&i| self.centroids[i as usize]));
+        let cb = self.union_of(idx, |i| Aabb::new(self.centroids[i as usize], self.centroids[i as usize]));
         let axis = cb.max_axis();
         let extent = cb.max[axis] - cb.min[axis];
         if extent <= 0.0 {
@@ -109,23 +109,15 @@ impl Ctx<'_> {
     fn split_sah(&self, idx: &mut [u32], bounds: &Aabb, cb: &Aabb) -> Option<usize> {
         let nb = self.bins;
         let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, plane)
-        let mut bin_bounds = vec![Aabb::EMPTY; nb];
-        let mut bin_count = vec![0usize; nb];
         let mut right_area = vec![0.0f32; nb];
         let mut right_count = vec![0usize; nb];
+        let bins = self.bin(idx, cb);
         for axis in 0..3 {
             let (lo, hi) = (cb.min[axis], cb.max[axis]);
             if hi <= lo {
                 continue;
             }
-            let scale = nb as f32 / (hi - lo);
-            bin_bounds.fill(Aabb::EMPTY);
-            bin_count.fill(0);
-            for &i in idx.iter() {
-                let b = bin_of(self.centroids[i as usize][axis], lo, scale, nb);
-                bin_bounds[b] = bin_bounds[b].union(self.bounds[i as usize]);
-                bin_count[b] += 1;
-            }
+            let (bin_bounds, bin_count) = (&bins.bounds[axis * nb..(axis + 1) * nb], &bins.count[axis * nb..(axis + 1) * nb]);
             let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
             for p in (1..nb).rev() {
                 acc = acc.union(bin_bounds[p]);
@@ -160,6 +152,72 @@ impl Ctx<'_> {
         let m = partition(idx, |i| bin_of(self.centroids[i as usize][axis], lo, scale, nb) < plane);
         debug_assert!(m > 0 && m < idx.len());
         Some(m)
+    }
+}
+
+/// Bins of the three axes, `nb` per axis (axis-major): the union of the boxes whose
+/// centroid falls in each bin, and their count.
+struct Bins {
+    bounds: Vec<Aabb>,
+    count: Vec<usize>,
+}
+
+impl Bins {
+    fn new(nb: usize) -> Self {
+        Self { bounds: vec![Aabb::EMPTY; 3 * nb], count: vec![0; 3 * nb] }
+    }
+
+    fn merge(mut self, o: Bins) -> Bins {
+        for (a, b) in self.bounds.iter_mut().zip(o.bounds) {
+            *a = a.union(b);
+        }
+        for (a, b) in self.count.iter_mut().zip(o.count) {
+            *a += b;
+        }
+        self
+    }
+}
+
+/// Nodes with at least this many primitives are binned in parallel (the top levels of the
+/// tree, where `rayon::join` over subtrees has not yet spread the work).
+const PARALLEL_BINNING: usize = 1 << 15;
+const BIN_CHUNK: usize = 1 << 13;
+
+impl Ctx<'_> {
+    /// The union of `f(i)` over `idx`, in parallel for large nodes (unions are exact: the
+    /// same box whatever the split of the work).
+    fn union_of(&self, idx: &[u32], f: impl Fn(u32) -> Aabb + Sync) -> Aabb {
+        if idx.len() < PARALLEL_BINNING {
+            return idx.iter().fold(Aabb::EMPTY, |b, &i| b.union(f(i)));
+        }
+        idx.par_chunks(BIN_CHUNK).map(|part| part.iter().fold(Aabb::EMPTY, |b, &i| b.union(f(i)))).reduce(|| Aabb::EMPTY, Aabb::union)
+    }
+
+    /// Bins `idx` along the three axes of the centroid box `cb` (axes of zero extent get
+    /// empty bins). Unions and counts are exact, so splitting the work over threads gives
+    /// the same bins, hence the same tree, whatever the thread count.
+    fn bin(&self, idx: &[u32], cb: &Aabb) -> Bins {
+        let nb = self.bins;
+        let scale: [f32; 3] = std::array::from_fn(|a| if cb.max[a] > cb.min[a] { nb as f32 / (cb.max[a] - cb.min[a]) } else { 0.0 });
+        let bin_part = |part: &[u32]| {
+            let mut bins = Bins::new(nb);
+            for &i in part {
+                let c = self.centroids[i as usize];
+                let b = self.bounds[i as usize];
+                for axis in 0..3 {
+                    if scale[axis] > 0.0 {
+                        let k = axis * nb + bin_of(c[axis], cb.min[axis], scale[axis], nb);
+                        bins.bounds[k] = bins.bounds[k].union(b);
+                        bins.count[k] += 1;
+                    }
+                }
+            }
+            bins
+        };
+        if idx.len() < PARALLEL_BINNING {
+            return bin_part(idx);
+        }
+        idx.par_chunks(BIN_CHUNK).map(bin_part).reduce(|| Bins::new(nb), Bins::merge)
     }
 }
 

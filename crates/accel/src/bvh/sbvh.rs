@@ -22,6 +22,9 @@ use crate::{leaf_margin, BuildOptions, Primitives};
 /// so the tree does not depend on the order nodes are built in.
 const SPLIT_BUDGET: f32 = 1.0;
 
+/// Nodes with at least this many references build their two subtrees in parallel.
+const PARALLEL_THRESHOLD: usize = 4096;
+
 /// A reference to a primitive, bounded by the part of it inside this node.
 #[derive(Clone, Copy, Debug)]
 struct Ref {
@@ -100,11 +103,39 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
         let l = self.nodes.len();
         self.nodes.push(BvhNode::interior(Aabb::EMPTY, 0));
         self.nodes.push(BvhNode::interior(Aabb::EMPTY, 0));
-        let bl = self.node(l, left, depth + 1, left_budget);
-        let br = self.node(l + 1, right, depth + 1, rest - left_budget);
+        let right_budget = rest - left_budget;
+        let (bl, br) = if n >= PARALLEL_THRESHOLD {
+            // The right subtree goes to a builder of its own on another thread, then is
+            // appended after the left one: the layout of the serial build, on any thread count.
+            let mut sub = self.fork();
+            let (bl, br) = rayon::join(|| self.node(l, left, depth + 1, left_budget), || sub.node(0, right, depth + 1, right_budget));
+            self.append(l + 1, sub);
+            (bl, br)
+        } else {
+            (self.node(l, left, depth + 1, left_budget), self.node(l + 1, right, depth + 1, right_budget))
+        };
         let b = bl.union(br);
         self.nodes[slot] = BvhNode::interior(b, l as u32);
         b
+    }
+
+    /// An empty builder with the same settings, its root at slot 0.
+    fn fork(&self) -> Self {
+        let (sah, max_leaf, bins, min_overlap, margin) = (self.sah, self.max_leaf, self.bins, self.min_overlap, self.margin);
+        Builder { prims: self.prims, sah, max_leaf, bins, min_overlap, margin, nodes: vec![BvhNode::interior(Aabb::EMPTY, 0)], indices: Vec::new() }
+    }
+
+    /// Appends the tree of a forked builder: its root goes to `slot`, its other nodes and
+    /// its indices after ours, their references shifted accordingly.
+    fn append(&mut self, slot: usize, sub: Self) {
+        let (node_base, index_base) = (self.nodes.len() as u32 - 1, self.indices.len() as u32);
+        let shift = |mut n: BvhNode| {
+            n.left_first += if n.is_leaf() { index_base } else { node_base };
+            n
+        };
+        self.nodes[slot] = shift(sub.nodes[0]);
+        self.nodes.extend(sub.nodes[1..].iter().map(|&n| shift(n)));
+        self.indices.extend(sub.indices);
     }
 
     /// The cheaper of the best object and spatial splits, or `None` when a leaf is cheaper

@@ -76,6 +76,22 @@ pub fn boxes_portable<const W: usize>(node: &WideNode<W>, r: &RayBoxes, t_max: f
 #[target_feature(enable = "avx2")]
 pub unsafe fn boxes_avx2(node: &WideNode<8>, r: &RayBoxes, t_max: f32, tnear: &mut [f32; 8]) -> u32 {
     use std::arch::x86_64::*;
+    // SAFETY: AVX2 is enabled in this function.
+    let (t0, t1) = unsafe { slabs_avx2(node, r, t_max) };
+    // SAFETY: `tnear` holds 8 f32.
+    unsafe { _mm256_storeu_ps(tnear.as_mut_ptr(), t0) };
+    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32
+}
+
+/// The entry and exit distances of [`boxes_avx2`] (lane `l` hit when `t0 <= t1`).
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[inline]
+#[target_feature(enable = "avx2")]
+pub unsafe fn slabs_avx2(node: &WideNode<8>, r: &RayBoxes, t_max: f32) -> (std::arch::x86_64::__m256, std::arch::x86_64::__m256) {
+    use std::arch::x86_64::*;
     let mut t0 = _mm256_set1_ps(r.t_min);
     let mut t1 = _mm256_set1_ps(t_max);
     for a in 0..3 {
@@ -89,9 +105,7 @@ pub unsafe fn boxes_avx2(node: &WideNode<8>, r: &RayBoxes, t_max: f32, tnear: &m
         t0 = _mm256_max_ps(near, t0);
         t1 = _mm256_min_ps(far, t1);
     }
-    // SAFETY: `tnear` holds 8 f32.
-    unsafe { _mm256_storeu_ps(tnear.as_mut_ptr(), t0) };
-    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32
+    (t0, t1)
 }
 
 /// [`boxes_portable`] for four lanes with SSE2 (part of every x86-64 CPU).

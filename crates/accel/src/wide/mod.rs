@@ -6,11 +6,13 @@
 //! - `node.rs`: the memory layout and its byte budget;
 //! - `collapse.rs`: binary → wide, Embree's largest-area-first opening;
 //! - `kernels.rs`: box and triangle kernels, SIMD and portable with identical answers;
-//! - `traverse.rs`: closest and any hit, counting or not.
+//! - `traverse.rs`: closest and any hit, counting or not;
+//! - `packet.rs`: closest hits of 16-ray packets (4×4 tiles of camera rays).
 
 mod collapse;
 pub mod kernels;
 pub mod node;
+mod packet;
 mod traverse;
 
 use raylab_core::{Aabb, Ray};
@@ -20,6 +22,7 @@ use crate::{Accel, AccelStats, Counters, Hit, Primitives, ValidationError};
 use node::{is_leaf, leaf_blocks, ChildRef, TriBlock, WideNode, EMPTY};
 
 pub use collapse::LEAF_PRIMS;
+pub use packet::PACKET;
 
 /// Which kernels a traversal runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -98,6 +101,23 @@ impl<const W: usize> WideBvh<W> {
         self.any_dispatch::<P, false>(prims, ray, &mut Counters::default())
     }
 
+    /// Closest hits of a packet of at most [`PACKET`] rays, traversed together: `out[i]`
+    /// is exactly what [`WideBvh::intersect_fast`] returns for `rays[i]`.
+    ///
+    /// # Panics
+    /// If `rays` holds more than [`PACKET`] rays or `out` is not as long as `rays`.
+    pub fn intersect_packet<P: Primitives + ?Sized>(&self, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
+        #[cfg(target_arch = "x86_64")]
+        if self.kernel == Kernel::Simd {
+            if W == 8 {
+                // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
+                return unsafe { packet_avx2::<P, W>(self, prims, rays, out) };
+            }
+            return packet::closest::<P, W, true>(self, prims, rays, out);
+        }
+        packet::closest::<P, W, false>(self, prims, rays, out)
+    }
+
     #[inline]
     fn closest_dispatch<P: Primitives + ?Sized, const COUNT: bool>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
         #[cfg(target_arch = "x86_64")]
@@ -155,6 +175,12 @@ impl<const W: usize> WideBvh<W> {
 #[target_feature(enable = "avx2")]
 unsafe fn closest_avx2<P: Primitives + ?Sized, const W: usize, const COUNT: bool>(bvh: &WideBvh<W>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
     traverse::closest::<P, W, true, COUNT>(bvh, prims, ray, c)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn packet_avx2<P: Primitives + ?Sized, const W: usize>(bvh: &WideBvh<W>, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
+    packet::closest::<P, W, true>(bvh, prims, rays, out)
 }
 
 #[cfg(target_arch = "x86_64")]

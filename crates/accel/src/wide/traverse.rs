@@ -16,7 +16,7 @@ use super::kernels::{boxes_portable, triangle_candidates, RayBoxes, ROBUST_FAR};
 
 /// The triangle filter of the kernel in use (SSE2 on x86-64 for both SIMD widths).
 #[inline(always)]
-fn candidates<const SIMD: bool>(b: &TriBlock, s: &ShearedRay) -> u32 {
+pub(super) fn candidates<const SIMD: bool>(b: &TriBlock, s: &ShearedRay) -> u32 {
     #[cfg(target_arch = "x86_64")]
     if SIMD {
         return super::kernels::triangle_candidates_sse(b, s);
@@ -30,7 +30,7 @@ use crate::{Counters, Hit, PrimHit, Primitives};
 /// Stack entries: at most `W - 1` pushes per level and trees at most `MAX_DEPTH + 1`
 /// wide levels deep (a wide level consumes at least one binary level; a split leaf adds
 /// one), so `65 · 7 = 455` entries suffice for `W = 8`.
-const STACK: usize = 512;
+pub(super) const STACK: usize = 512;
 
 #[derive(Clone, Copy)]
 struct Entry {
@@ -46,7 +46,7 @@ struct Work {
 }
 
 #[inline(always)]
-fn child_boxes<const W: usize, const SIMD: bool>(node: &WideNode<W>, r: &RayBoxes, t_max: f32, tnear: &mut [f32; W]) -> u32 {
+pub(super) fn child_boxes<const W: usize, const SIMD: bool>(node: &WideNode<W>, r: &RayBoxes, t_max: f32, tnear: &mut [f32; W]) -> u32 {
     #[cfg(target_arch = "x86_64")]
     if SIMD {
         if W == 8 {
@@ -61,6 +61,16 @@ fn child_boxes<const W: usize, const SIMD: bool>(node: &WideNode<W>, r: &RayBoxe
         }
     }
     boxes_portable(node, r, t_max, tnear)
+}
+
+/// Whether a hit at `t` on `prim`, found with `t <= ray.t_max` (the current best's
+/// distance), replaces `best`: a nearer one does, and a tie goes to the lower primitive
+/// index. The answer is then the least `(t, prim)` over the primitives hit, whatever the
+/// order in which they were tested, so that packet traversal (another order) returns the
+/// same primitive as single-ray traversal on shared edges and coplanar overlaps.
+#[inline(always)]
+pub(super) fn wins(t: f32, prim: u32, best: &Option<Hit>) -> bool {
+    best.is_none_or(|b| t < b.t || prim < b.prim)
 }
 
 /// Closest hit among the blocks of a leaf; moves `ray.t_max` to each hit found.
@@ -81,8 +91,11 @@ fn leaf_closest<P: Primitives + ?Sized, const SIMD: bool, const COUNT: bool>(blo
                 s.triangle(ray.t_min, ray.t_max, b.vertex(l, 0), b.vertex(l, 1), b.vertex(l, 2)).map(|(t, u, v)| PrimHit { t, u, v })
             };
             if let Some(h) = hit {
-                ray.t_max = h.t;
-                *best = Some(Hit::new(p & !TriBlock::OTHER, h));
+                let prim = p & !TriBlock::OTHER;
+                if wins(h.t, prim, best) {
+                    ray.t_max = h.t;
+                    *best = Some(Hit::new(prim, h));
+                }
             }
         }
     }
@@ -114,7 +127,7 @@ fn leaf_any<P: Primitives + ?Sized, const SIMD: bool, const COUNT: bool>(blocks:
 }
 
 #[inline(always)]
-fn leaf_slice<const W: usize>(bvh: &WideBvh<W>, r: ChildRef) -> &[TriBlock] {
+pub(super) fn leaf_slice<const W: usize>(bvh: &WideBvh<W>, r: ChildRef) -> &[TriBlock] {
     let (first, n) = leaf_blocks(r);
     &bvh.blocks[first..first + n]
 }

@@ -71,6 +71,9 @@ pub struct SettingsArgs {
     /// Bins of the binned SAH builders (default 16)
     #[arg(long, value_parser = clap::value_parser!(u32).range(2..=1024))]
     pub bins: Option<u32>,
+    /// Builder under bvh, bvh4 and bvh8, as Embree's quality: low (LBVH, fastest build), medium (binned SAH, the default), high (SBVH with spatial splits, best tree); see docs/performance.md
+    #[arg(long, value_parser = named!(raylab_accel::BuildQuality))]
+    pub build_quality: Option<raylab_accel::BuildQuality>,
     /// Pixel reconstruction filter
     #[arg(long, value_enum)]
     pub filter: Option<PixelFilter>,
@@ -91,10 +94,11 @@ pub struct SettingsArgs {
 impl SettingsArgs {
     /// The overrides, with no spp or light sampling.
     pub fn overrides(&self) -> Result<Overrides> {
-        let build = (self.max_leaf_size.is_some() || self.bins.is_some()).then(|| {
+        let build = (self.max_leaf_size.is_some() || self.bins.is_some() || self.build_quality.is_some()).then(|| {
             let mut b = raylab_accel::BuildOptions::default();
             b.max_leaf_size = self.max_leaf_size.map_or(b.max_leaf_size, |n| n as usize);
             b.bins = self.bins.map_or(b.bins, |n| n as usize);
+            b.quality = self.build_quality.unwrap_or(b.quality);
             b
         });
         Ok(Overrides {

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use raylab_accel::{AccelKind, AnyAccel, BuildOptions};
+use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, BuildQuality};
 use raylab_loader::Overrides;
 
 #[derive(Args, Clone, Debug)]
@@ -19,6 +19,9 @@ pub struct TraceArgs {
     /// Acceleration structure
     #[arg(long, default_value = "bvh")]
     pub accel: String,
+    /// Builder under bvh, bvh4 and bvh8: low (LBVH), medium (binned SAH), high (SBVH)
+    #[arg(long, default_value = "medium", value_parser = |s: &str| s.parse::<BuildQuality>())]
+    pub build_quality: BuildQuality,
     /// Any-hit (shadow) queries instead of closest hits
     #[arg(long)]
     pub any_hit: bool,
@@ -28,6 +31,11 @@ pub struct TraceArgs {
     /// Timed passes after one warm-up; the median is reported
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub repeats: u32,
+    /// Trace closest hits in packets of N consecutive rays traversed together (16 = one
+    /// 4×4 tile of the primary rays `raylab bench --dump-rays` writes; wide BVHs only,
+    /// other structures trace the packet's rays one by one)
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=raylab_accel::PACKET as i64))]
+    pub packet: Option<u32>,
     /// Print JSON
     #[arg(long)]
     pub json: bool,
@@ -35,6 +43,9 @@ pub struct TraceArgs {
 
 pub fn run(a: &TraceArgs) -> Result<()> {
     let kind: AccelKind = a.accel.parse().map_err(|e| anyhow::anyhow!("--accel: {e}"))?;
+    if a.packet.is_some() && a.any_hit {
+        anyhow::bail!("--packet traces closest hits only: drop --any-hit or --packet");
+    }
     let rays = raylab_lab::rayfile::read(&a.rays)?;
     let mut b = rayon::ThreadPoolBuilder::new();
     if let Some(t) = a.threads {
@@ -43,11 +54,15 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     let pool = b.build()?;
     pool.install(|| -> Result<()> {
         let scene = raylab_loader::load_scene_or_mesh(&a.scene, &Overrides { accel: Some(AccelKind::None), ..Default::default() })?;
-        let accel = AnyAccel::build(kind, &scene.geometry, &BuildOptions::default());
+        let accel = AnyAccel::build(kind, &scene.geometry, &BuildOptions { quality: a.build_quality, ..Default::default() });
+        let build_ms = accel.stats().build_ms;
         let mut results = Vec::new();
         for _ in 0..=a.repeats {
             // Nothing here prints counters: the fast path, with counting compiled out.
-            results.push(raylab_lab::trace::trace_counting(&accel, &scene.geometry, &rays, a.any_hit, false));
+            results.push(match a.packet {
+                Some(n) => raylab_lab::trace::trace_packets(&accel, &scene.geometry, &rays, n as usize),
+                None => raylab_lab::trace::trace_counting(&accel, &scene.geometry, &rays, a.any_hit, false),
+            });
         }
         let mut secs: Vec<f64> = results[1..].iter().map(|r| r.seconds).collect();
         secs.sort_by(f64::total_cmp);
@@ -57,10 +72,15 @@ pub fn run(a: &TraceArgs) -> Result<()> {
         if a.json {
             println!(
                 "{}",
-                serde_json::json!({ "rays": r.count, "hits": r.hits, "t_sum": r.t_sum, "seconds": seconds, "mrays_per_s": mrays, "accel": kind.name(), "any_hit": a.any_hit, "threads": rayon::current_num_threads() })
+                serde_json::json!({ "rays": r.count, "hits": r.hits, "t_sum": r.t_sum, "seconds": seconds, "mrays_per_s": mrays, "accel": kind.name(), "build_quality": a.build_quality.name(), "build_ms": build_ms, "any_hit": a.any_hit, "packet": a.packet.unwrap_or(1), "threads": rayon::current_num_threads() })
             );
         } else {
-            println!("rays {}  hits {}  t_sum {:.6}  {:.2} Mrays/s ({}, {}, median of {} on {} threads)", r.count, r.hits, r.t_sum, mrays, kind, if a.any_hit { "any hit" } else { "closest hit" }, a.repeats, rayon::current_num_threads());
+            let query = match a.packet {
+                Some(n) => format!("closest hit, packets of {n}"),
+                None if a.any_hit => "any hit".into(),
+                None => "closest hit".into(),
+            };
+            println!("rays {}  hits {}  t_sum {:.6}  {:.2} Mrays/s ({}, {}, median of {} on {} threads; built in {build_ms:.1} ms at {} quality)", r.count, r.hits, r.t_sum, mrays, kind, query, a.repeats, rayon::current_num_threads(), a.build_quality);
         }
         Ok(())
     })

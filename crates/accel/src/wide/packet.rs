@@ -1,0 +1,209 @@
+//! Closest hits of a packet of up to [`PACKET`] rays (a 4×4 tile of camera rays) through
+//! a wide BVH: the packet walks the tree together, each stack entry carrying the mask of
+//! rays that entered the child, so a node is loaded once for all the rays that reach it
+//! and the stack, the ordering and the loop run once per packet instead of once per ray.
+//!
+//! Each active ray tests a node's `W` child boxes with the single-ray kernel (AVX2 or
+//! portable), and each candidate triangle with the same exact kernel, so the answers are
+//! those of single-ray traversal bit for bit: hits are kept as the least `(t, prim)`
+//! (see [`super::traverse::wins`]), which does not depend on the order of the tests, and
+//! a ray's box tests are as conservative as when it travels alone.
+
+use std::mem::MaybeUninit;
+
+use raylab_core::intersect::ShearedRay;
+use raylab_core::Ray;
+
+#[cfg(target_arch = "x86_64")]
+use super::kernels::slabs_avx2;
+use super::kernels::{RayBoxes, ROBUST_FAR};
+use super::node::{is_leaf, ChildRef, TriBlock, WideNode, EMPTY};
+use super::traverse::{candidates, child_boxes, leaf_slice, wins, STACK};
+use super::WideBvh;
+use crate::{Hit, PrimHit, Primitives};
+
+/// Rays per packet: a 4×4 tile, one bit each in a [`RayMask`].
+pub const PACKET: usize = 16;
+
+/// Bit `r` set: ray `r` of the packet is active.
+type RayMask = u32;
+
+#[derive(Clone, Copy)]
+struct Entry {
+    node: ChildRef,
+    rays: RayMask,
+    /// The least entry distance of those rays.
+    t: f32,
+}
+
+/// Iterates over the set bits of a mask, lowest first.
+#[inline(always)]
+fn bits(mut m: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (m != 0).then(|| {
+            let b = m.trailing_zeros() as usize;
+            m &= m - 1;
+            b
+        })
+    })
+}
+
+/// Tests the children of `node` against the `active` rays: `entered[l]` gets the rays
+/// entering child `l`, `nearest[l]` their least entry distance; returns the children
+/// entered by any ray.
+#[inline(always)]
+fn node_boxes<const W: usize, const SIMD: bool>(node: &WideNode<W>, rb: &[RayBoxes; PACKET], far: &[f32; PACKET], active: RayMask, entered: &mut [RayMask; W], nearest: &mut [f32; W]) -> u32 {
+    #[cfg(target_arch = "x86_64")]
+    if SIMD && W == 8 {
+        // SAFETY: `W == 8`, so these are the same types; SIMD = true with W = 8 is only
+        // instantiated inside `#[target_feature(enable = "avx2")]` functions that the
+        // build selects after `is_x86_feature_detected!("avx2")`.
+        return unsafe {
+            node_boxes_avx2(&*(node as *const WideNode<W>).cast::<WideNode<8>>(), rb, far, active, &mut *(entered as *mut [RayMask; W]).cast::<[RayMask; 8]>(), &mut *(nearest as *mut [f32; W]).cast::<[f32; 8]>())
+        };
+    }
+    let mut any = 0u32;
+    for r in bits(active) {
+        let mut tnear = [0.0f32; W];
+        let m = child_boxes::<W, SIMD>(node, &rb[r], far[r], &mut tnear);
+        any |= m;
+        for l in bits(m) {
+            entered[l] |= 1 << r;
+            nearest[l] = nearest[l].min(tnear[l]);
+        }
+    }
+    any
+}
+
+/// [`node_boxes`] for 8-wide nodes with AVX2: each ray's slab test as in single-ray
+/// traversal ([`slabs_avx2`]), its hit lanes or-ed into the children's ray masks and its
+/// entry distances min-ed into theirs in registers, with no per-lane loop.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[inline]
+#[target_feature(enable = "avx2")]
+unsafe fn node_boxes_avx2(node: &WideNode<8>, rb: &[RayBoxes; PACKET], far: &[f32; PACKET], active: RayMask, entered: &mut [RayMask; 8], nearest: &mut [f32; 8]) -> u32 {
+    use std::arch::x86_64::*;
+    let mut rays = _mm256_setzero_si256();
+    let mut near = _mm256_set1_ps(f32::INFINITY);
+    for r in bits(active) {
+        // SAFETY: AVX2 is enabled in this function.
+        let (t0, t1) = unsafe { slabs_avx2(node, &rb[r], far[r]) };
+        let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1);
+        rays = _mm256_or_si256(rays, _mm256_and_si256(_mm256_castps_si256(hit), _mm256_set1_epi32(1 << r)));
+        // Entry distances are never NaN (the slab test's `max` keeps `t_min` over a NaN).
+        near = _mm256_min_ps(near, _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), t0, hit));
+    }
+    // SAFETY: both arrays hold 8 lanes of 4 bytes.
+    unsafe {
+        _mm256_storeu_si256(entered.as_mut_ptr().cast(), rays);
+        _mm256_storeu_ps(nearest.as_mut_ptr(), near);
+    }
+    // Ray masks are below 2^16, so "non-zero" is "greater than zero".
+    _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(rays, _mm256_setzero_si256()))) as u32
+}
+
+/// Closest hits of `rays` (at most [`PACKET`]) into `out` (as long as `rays`).
+#[inline(always)]
+pub(super) fn closest<P: Primitives + ?Sized, const W: usize, const SIMD: bool>(bvh: &WideBvh<W>, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
+    let n = rays.len();
+    assert!(n <= PACKET && out.len() == n, "a packet holds at most {PACKET} rays and as many answers");
+    out.fill(None);
+    if bvh.root == EMPTY || n == 0 {
+        return;
+    }
+    // Lanes past `n` repeat the last ray and are never active.
+    let mut ray: [Ray; PACKET] = std::array::from_fn(|r| rays[r.min(n - 1)]);
+    let rb: [RayBoxes; PACKET] = std::array::from_fn(|r| RayBoxes::new(&ray[r]));
+    let sheared: [ShearedRay; PACKET] = std::array::from_fn(|r| ShearedRay::new(&ray[r]));
+    // Each ray's far limit for box tests, widened as in single-ray traversal.
+    let mut far: [f32; PACKET] = std::array::from_fn(|r| ray[r].t_max * ROBUST_FAR);
+    let mut stack = [const { MaybeUninit::<Entry>::uninit() }; STACK];
+    let mut sp = 0usize;
+    let mut cur = bvh.root;
+    let mut active: RayMask = (1 << n) - 1;
+    'walk: loop {
+        if is_leaf(cur) {
+            for b in leaf_slice(bvh, cur) {
+                for r in bits(active) {
+                    let s = &sheared[r];
+                    let mut m = candidates::<SIMD>(b, s);
+                    while m != 0 {
+                        let l = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        let p = b.prim[l];
+                        let prim = p & !TriBlock::OTHER;
+                        let hit = if p & TriBlock::OTHER != 0 {
+                            prims.intersect(prim, &ray[r])
+                        } else {
+                            s.triangle(ray[r].t_min, ray[r].t_max, b.vertex(l, 0), b.vertex(l, 1), b.vertex(l, 2)).map(|(t, u, v)| PrimHit { t, u, v })
+                        };
+                        if let Some(h) = hit {
+                            if wins(h.t, prim, &out[r]) {
+                                ray[r].t_max = h.t;
+                                far[r] = h.t * ROBUST_FAR;
+                                out[r] = Some(Hit::new(prim, h));
+                            }
+                        }
+                    }
+                }
+            }
+        } else {
+            let node = &bvh.nodes[cur as usize];
+            // Per child: the rays entering it and their least entry distance.
+            let mut entered = [0 as RayMask; W];
+            let mut nearest = [f32::INFINITY; W];
+            let any = node_boxes::<W, SIMD>(node, &rb, &far, active, &mut entered, &mut nearest);
+            if any != 0 {
+                if any & (any - 1) == 0 {
+                    let l = any.trailing_zeros() as usize;
+                    cur = node.child[l];
+                    active = entered[l];
+                    continue 'walk;
+                }
+                // Nearest child first, as in single-ray traversal (keys: distance bits
+                // with the lane in the low bits).
+                let lane_bits = W as u32 - 1;
+                let mut keys = [0u32; W];
+                let mut k = 0;
+                for l in bits(any) {
+                    let key = (nearest[l].to_bits() & !lane_bits) | l as u32;
+                    let mut j = k;
+                    while j > 0 && keys[j - 1] > key {
+                        keys[j] = keys[j - 1];
+                        j -= 1;
+                    }
+                    keys[j] = key;
+                    k += 1;
+                }
+                for &key in keys[1..k].iter().rev() {
+                    let l = (key & lane_bits) as usize;
+                    stack[sp] = MaybeUninit::new(Entry { node: node.child[l], rays: entered[l], t: nearest[l] });
+                    sp += 1;
+                }
+                let l = (keys[0] & lane_bits) as usize;
+                cur = node.child[l];
+                active = entered[l];
+                continue 'walk;
+            }
+        }
+        while sp > 0 {
+            sp -= 1;
+            // SAFETY: entries below `sp` were written by the pushes above.
+            let e = unsafe { stack[sp].assume_init() };
+            // Rays whose hit so far is nearer than every entry into the child drop out.
+            let mut alive = 0;
+            for r in bits(e.rays) {
+                alive |= RayMask::from(e.t <= far[r]) << r;
+            }
+            if alive != 0 {
+                cur = e.node;
+                active = alive;
+                continue 'walk;
+            }
+        }
+        break;
+    }
+}

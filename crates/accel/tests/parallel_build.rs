@@ -1,0 +1,39 @@
+//! Parallel builds are deterministic: the same tree, node for node, whatever the number
+//! of threads (subtrees built by `rayon::join`, large nodes binned in parallel).
+
+use raylab_accel::bvh::{self, Bvh, SplitMethod};
+use raylab_accel::{Accel, BuildOptions, Primitives, WideBvh};
+use raylab_testkit as kit;
+
+fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(f)
+}
+
+fn same_tree(name: &str, a: &Bvh, b: &Bvh) {
+    assert_eq!(a.indices, b.indices, "{name}: primitive order");
+    assert!(a.nodes == b.nodes, "{name}: nodes differ");
+}
+
+/// The 69k-triangle bunny is large enough for the root's binning to run in parallel.
+#[test]
+fn builds_do_not_depend_on_the_thread_count() {
+    let soup = kit::read_obj_triangles(&kit::shared_scenes().join("bunny_69451.obj"));
+    assert!(soup.len() > 65_536);
+    let opts = BuildOptions::default();
+    let builders: [(&str, fn(&kit::Soup, &BuildOptions) -> Bvh); 3] =
+        [("bvh", |s, o| Bvh::build(s, SplitMethod::BinnedSah, o)), ("sbvh", |s, o| bvh::sbvh::build(s, o)), ("lbvh-ploc", |s, o| bvh::ploc::build(s, o))];
+    for (name, build) in builders {
+        let one = on_threads(1, || build(&soup, &opts));
+        one.validate(&soup).unwrap();
+        for threads in [2, 3] {
+            let many = on_threads(threads, || build(&soup, &opts));
+            same_tree(&format!("{name} on {threads} threads"), &one, &many);
+        }
+        if name == "bvh" {
+            let w1 = WideBvh::<8>::from_binary(&one, &soup, "bvh8");
+            let w2 = on_threads(2, || WideBvh::<8>::from_binary(&build(&soup, &opts), &soup, "bvh8"));
+            w1.validate(&soup).unwrap();
+            assert!(w1.nodes == w2.nodes && w1.blocks == w2.blocks, "bvh8 differs on 2 threads");
+        }
+    }
+}
