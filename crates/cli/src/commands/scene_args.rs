@@ -72,7 +72,7 @@ pub struct SettingsArgs {
     #[arg(long, value_parser = clap::value_parser!(u32).range(2..=1024))]
     pub bins: Option<u32>,
     /// Builder under bvh, bvh4 and bvh8, as Embree's quality: low (LBVH, fastest build), medium (binned SAH, the default), high (SBVH with spatial splits, best tree); see docs/performance.md
-    #[arg(long, value_parser = named!(raylab_accel::BuildQuality))]
+    #[arg(long, value_enum)]
     pub build_quality: Option<raylab_accel::BuildQuality>,
     /// Pixel reconstruction filter
     #[arg(long, value_enum)]

@@ -20,7 +20,7 @@ pub struct TraceArgs {
     #[arg(long, default_value = "bvh")]
     pub accel: String,
     /// Builder under bvh, bvh4 and bvh8: low (LBVH), medium (binned SAH), high (SBVH)
-    #[arg(long, default_value = "medium", value_parser = |s: &str| s.parse::<BuildQuality>())]
+    #[arg(long, default_value = "medium", value_enum)]
     pub build_quality: BuildQuality,
     /// Any-hit (shadow) queries instead of closest hits
     #[arg(long)]
