@@ -31,4 +31,15 @@ impl<P: Primitives + Sync + ?Sized> Peer for RaylabPeer<'_, P> {
     fn occluded(&self, ray: &Ray) -> bool {
         self.accel.occluded_fast(self.prims, ray)
     }
+    fn intersect16(&self, rays: &[Ray], out: &mut [Option<PeerHit>]) {
+        let mut hits = [None; raylab_accel::PACKET];
+        self.accel.intersect_packet(self.prims, rays, &mut hits[..rays.len()]);
+        for (o, h) in out.iter_mut().zip(&hits) {
+            *o = h.map(|h| PeerHit { t: h.t, prim: h.prim });
+        }
+    }
+    /// The wide BVHs trace packets together; the other structures one ray at a time.
+    fn has_packets(&self) -> bool {
+        matches!(self.kind, AccelKind::Bvh8 | AccelKind::Bvh4)
+    }
 }

@@ -147,8 +147,10 @@ fn bench_scene(a: &BenchArgs, path: Option<&PathBuf>, accels: &[AccelKind], peer
             harness::closest(&oracle, &set.rays, &mut set.closest);
         }
         if s.kind == RayKind::Primary {
+            // The lab's primary rays already come in 4×4 tiles (rays::tile_order, the order
+            // TilePackets describes): the packets are consecutive ranges of them.
             let tiles = TilePackets::new(a.resolution, height);
-            sets.push(Set { name: PACKETS.into(), any_hit: false, rays: tiles.reorder(&set.rays), packets: Some(tiles.packets.clone()), closest: tiles.reorder(&set.closest), occluded: Vec::new() });
+            sets.push(Set { name: PACKETS.into(), any_hit: false, rays: set.rays.clone(), packets: Some(tiles.packets), closest: set.closest.clone(), occluded: Vec::new() });
         }
         sets.push(set);
     }
@@ -265,4 +267,18 @@ fn bench_scene(a: &BenchArgs, path: Option<&PathBuf>, accels: &[AccelKind], peer
         bail!("{name}: answers differ from the oracle beyond the tolerance (docs/performance.md):\n  {}", failures.join("\n  "));
     }
     Ok(SceneFigures { scene: name, triangles: n, oracle: oracle_kind.name().into(), structures })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The packets are ranges of the lab's primary rays: both must use the same tile order.
+    #[test]
+    fn packets_follow_the_lab_tile_order() {
+        for (w, h) in [(6, 5), (16, 8), (7, 9)] {
+            let lab: Vec<u32> = rays::tile_order(w, h).map(|(x, y)| y * w + x).collect();
+            assert_eq!(TilePackets::new(w, h).order, lab, "{w}x{h}");
+        }
+    }
 }
