@@ -50,7 +50,7 @@ def test_bad_overrides():
         raylab.render(None, integrator="pathtracer")
     with pytest.raises(ValueError, match=r"^accel: unknown acceleration structure `octree` \(valid: none, bvh, "):
         raylab.Scene(None, accel="octree")
-    with pytest.raises(TypeError, match=r"^render\(\) got an unexpected keyword argument 'sample_count' \(valid: spp, width, "):
+    with pytest.raises(TypeError, match=r"^render\(\) got an unexpected keyword argument 'sample_count' \(valid: width, height, spp, "):
         raylab.render(None, sample_count=4)
     with pytest.raises(TypeError, match=r"^sampler: expected a string, found int$"):
         raylab.render(None, sampler=3)
