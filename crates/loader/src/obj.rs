@@ -121,7 +121,8 @@ fn short_faces_warning(path: &Path, text: &str) -> Option<String> {
 }
 
 /// The MTL statements raylab uses, checked before tobj reads them (tobj takes `nan` and
-/// negative colours as given): colours finite and not negative, scalars finite.
+/// negative colours as given, and panics on a colour of fewer than 3 numbers): colours of 3
+/// finite numbers, not negative; scalars finite.
 fn check_mtl(path: &Path, bytes: &[u8]) -> Result<(), LoadError> {
     let text = String::from_utf8_lossy(bytes);
     for (i, line) in text.lines().enumerate() {
@@ -140,6 +141,10 @@ fn check_mtl(path: &Path, bytes: &[u8]) -> Result<(), LoadError> {
         let err = |m: &str| Err(LoadError::new(path, Some(i + 1), kw, format!("{m}, found `{}`", shorten(&rest.join(" ")))));
         if values.iter().any(|v| !v.is_finite()) {
             return err("expected finite numbers");
+        }
+        // tobj panics on a colour of fewer than 3 numbers (found by the obj_mtl fuzz target).
+        if matches!(kw, "Ka" | "Kd" | "Ks" | "Ke") && values.len() < 3 {
+            return err("expected 3 numbers (r g b)");
         }
         if (colour || kw == "Ns") && values.iter().any(|&v| v < 0.0) {
             return err("must not be negative");

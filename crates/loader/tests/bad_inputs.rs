@@ -43,6 +43,11 @@ fn mtl_values_must_be_finite_and_colours_not_negative() {
     assert_eq!(error_in(&dir, &mesh_scene("t.obj")), format!("{}:2: Ks: must not be negative, found `0 -0.5 0`", dir.join("m.mtl").display()));
     let dir = folder("mtl-ns", &[("t.obj", obj.as_bytes()), ("m.mtl", b"newmtl a\nNs inf\n")]);
     assert_eq!(error_in(&dir, &mesh_scene("t.obj")), format!("{}:2: Ns: expected finite numbers, found `inf`", dir.join("m.mtl").display()));
+    // tobj panicked on these (found by the obj_mtl fuzz target).
+    let dir = folder("mtl-short", &[("t.obj", obj.as_bytes()), ("m.mtl", b"newmtl a\nKd 0.20\n")]);
+    assert_eq!(error_in(&dir, &mesh_scene("t.obj")), format!("{}:2: Kd: expected 3 numbers (r g b), found `0.20`", dir.join("m.mtl").display()));
+    let dir = folder("mtl-empty", &[("t.obj", obj.as_bytes()), ("m.mtl", b"newmtl a\nKa\n")]);
+    assert_eq!(error_in(&dir, &mesh_scene("t.obj")), format!("{}:2: Ka: expected 3 numbers (r g b), found ``", dir.join("m.mtl").display()));
     // A valid file still loads.
     let dir = folder("mtl-ok", &[("t.obj", obj.as_bytes()), ("m.mtl", b"newmtl a\nKd 0.5 0.5 0.5\nNs 10\n")]);
     load_scene_str(&mesh_scene("t.obj"), Path::new("s.toml"), &Resolver::Disk { base: dir }, &Overrides::default()).unwrap();
