@@ -59,14 +59,7 @@ pub fn trace_counting<P: Primitives + ?Sized>(accel: &AnyAccel, prims: &P, rays:
                 (hits, t_sum)
             })
             .collect();
-        let seconds = start.elapsed().as_secs_f64();
-        let mut out = TraceResult { count: rays.len() as u64, seconds, ..Default::default() };
-        out.counters.rays = out.count;
-        for (h, t) in parts {
-            out.hits += h;
-            out.t_sum += t;
-        }
-        return out;
+        return summed(rays.len(), start.elapsed().as_secs_f64(), parts);
     }
     let start = Instant::now();
     let parts: Vec<(u64, f64, Counters)> = rays
@@ -119,8 +112,13 @@ pub fn trace_packets<P: Primitives + ?Sized>(accel: &AnyAccel, prims: &P, rays: 
             (hits, t_sum)
         })
         .collect();
-    let seconds = start.elapsed().as_secs_f64();
-    let mut out = TraceResult { count: rays.len() as u64, seconds, ..Default::default() };
+    summed(rays.len(), start.elapsed().as_secs_f64(), parts)
+}
+
+/// The result of an uncounted trace from its chunks' hits and distance sums, summed in
+/// chunk order (so the sum does not depend on the thread count).
+fn summed(count: usize, seconds: f64, parts: Vec<(u64, f64)>) -> TraceResult {
+    let mut out = TraceResult { count: count as u64, seconds, ..Default::default() };
     out.counters.rays = out.count;
     for (h, t) in parts {
         out.hits += h;
