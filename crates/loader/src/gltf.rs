@@ -1,7 +1,7 @@
 //! The glTF 2.0 front end (`.gltf` with its `.bin`, and `.glb`), through the `gltf` crate:
 //! the default scene's node hierarchy and transforms, triangle meshes (positions, normals,
 //! first UV set), the metallic-roughness material mapped to raylab's materials (table in
-//! `docs/scene-format.md`), base-colour and (tangent-space) normal textures, perspective
+//! `docs/scene-format.md`), base-colour, metallic-roughness and (tangent-space) normal textures, perspective
 //! cameras and `KHR_lights_punctual` (point, directional, spot); buffers and images in files, in the GLB's binary
 //! chunk or in base64 `data:` URIs. Without a camera the model is framed as a bare mesh is.
 
@@ -9,11 +9,10 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use raylab_core::{Rgb, Transform, Vec2, Vec3};
-use raylab_render::bsdf::{Distribution, Geometry as MicrofacetGeometry};
 use raylab_render::material::TexColor;
 use raylab_render::shading::{NormalSpace, ShadingPerturbation};
 use raylab_render::texture::{Filter, ImageTexture, Wrap};
-use raylab_render::{Light, Material, MaterialId, Texture, TriangleMesh};
+use raylab_render::{Light, Material, MaterialId, Texture, TextureId, TriangleMesh};
 
 use crate::description::{CameraDescription, SceneDescription, Span};
 use crate::error::LoadError;
@@ -144,8 +143,10 @@ fn data_uri(data: &str) -> Result<Vec<u8>, String> {
     base64::decode(payload.trim()).map_err(|e| format!("the base64 payload of `data:{header},...` does not decode: {e}"))
 }
 
-/// An image texture of the file: decoded from sRGB for colours, linear for normal maps.
-fn image_texture(path: &Path, buffers: &[Vec<u8>], read_uri: &dyn Fn(&str, &str) -> Result<Vec<u8>, LoadError>, texture: gltf::Texture, srgb: bool, field: &str) -> Result<ImageTexture, LoadError> {
+/// An image texture of the file, its texels times `scale`: decoded from sRGB for colours,
+/// linear for data (normals, metalness and roughness).
+#[allow(clippy::too_many_arguments)]
+fn image_texture(path: &Path, buffers: &[Vec<u8>], read_uri: &dyn Fn(&str, &str) -> Result<Vec<u8>, LoadError>, texture: gltf::Texture, srgb: bool, scale: Rgb, field: &str) -> Result<ImageTexture, LoadError> {
     let bytes = match texture.source().source() {
         gltf::image::Source::View { view, .. } => {
             let buffer = &buffers[view.buffer().index()];
@@ -153,13 +154,19 @@ fn image_texture(path: &Path, buffers: &[Vec<u8>], read_uri: &dyn Fn(&str, &str)
         }
         gltf::image::Source::Uri { uri, .. } => read_uri(field, uri)?,
     };
-    let (w, h, texels) = crate::image_io::decode_image(path, &bytes, srgb).map_err(|e| LoadError::new(path, None, field, e.to_string()))?;
+    let (w, h, mut texels) = crate::image_io::decode_image(path, &bytes, srgb).map_err(|e| LoadError::new(path, None, field, e.to_string()))?;
+    if scale != Rgb::ONE {
+        texels.iter_mut().for_each(|t| *t *= scale);
+    }
     ImageTexture::new(w, h, texels, Wrap::Repeat, Filter::Bilinear).map_err(|e| LoadError::new(path, None, field, e.to_string()))
 }
 
-/// Maps a metallic-roughness material: a rough dielectric (metallic 0, roughness 1) is
-/// `diffuse`; anything else the glTF BRDF itself, `cooktorrance` with diffuse
-/// `base·(1 - metallic)`, `f0 = lerp(0.04, base, metallic)` and GGX α = roughness².
+/// Maps a metallic-roughness material: a rough dielectric without a metallic-roughness
+/// texture (metallic 0, roughness 1) is `diffuse`; anything else raylab's
+/// `metallic-roughness` material, the glTF BRDF itself (Cook–Torrance with diffuse
+/// `base·(1 - metallic)`, `f0 = lerp(0.04, base, metallic)`, GGX α = roughness²), with the
+/// metallic-roughness texture read per shading point. The base-colour factor multiplies the
+/// texture's texels on load (exact: filtering is linear).
 fn material(path: &Path, doc: &gltf::Gltf, buffers: &[Vec<u8>], read_uri: &dyn Fn(&str, &str) -> Result<Vec<u8>, LoadError>, k: usize, desc: &mut SceneDescription) -> Result<MaterialId, LoadError> {
     let m = doc.materials().nth(k).expect("index from the file");
     let pbr = m.pbr_metallic_roughness();
@@ -167,26 +174,34 @@ fn material(path: &Path, doc: &gltf::Gltf, buffers: &[Vec<u8>], read_uri: &dyn F
     let base = Rgb::new(r, g, b);
     let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
     let field = format!("materials[{k}]");
-    let base_color = match pbr.base_color_texture() {
-        Some(info) => {
-            let tex = image_texture(path, buffers, read_uri, info.texture(), true, &format!("{field}.baseColorTexture"))?;
-            // The factor multiplies the texture; a white factor (the usual one) is the texture itself.
-            if base != Rgb::ONE {
-                desc.warnings.push(format!("{}: {field}: baseColorFactor {base} times a texture is read as the texture alone", path.display()));
-            }
-            TexColor::Texture(desc.add_texture(format!("{field}.baseColorTexture"), Texture::Image(tex)))
+    let texture = |info: gltf::texture::Info, srgb: bool, scale: Rgb, name: String, desc: &mut SceneDescription| -> Result<TextureId, LoadError> {
+        if info.tex_coord() != 0 {
+            desc.warnings.push(format!("{}: {name}: texCoord {} is read as 0 (raylab keeps the first UV set)", path.display(), info.tex_coord()));
         }
+        let tex = image_texture(path, buffers, read_uri, info.texture(), srgb, scale, &name)?;
+        Ok(desc.add_texture(name, Texture::Image(tex)))
+    };
+    let base_color = match pbr.base_color_texture() {
+        Some(info) => TexColor::Texture(texture(info, true, base, format!("{field}.baseColorTexture"), desc)?),
         None => TexColor::Constant(base),
     };
-    let material = if metallic == 0.0 && roughness >= 1.0 {
+    let metallic_roughness = pbr.metallic_roughness_texture().map(|info| texture(info, false, Rgb::ONE, format!("{field}.metallicRoughnessTexture"), desc)).transpose()?;
+    // Ambient occlusion is what a path tracer computes; a baked copy would count it twice.
+    if m.occlusion_texture().is_some() {
+        desc.warnings.push(format!("{}: {field}.occlusionTexture is ignored (the path tracer computes occlusion)", path.display()));
+    }
+    let alpha = match m.alpha_mode() {
+        gltf::material::AlphaMode::Opaque => None,
+        gltf::material::AlphaMode::Mask => Some("MASK"),
+        gltf::material::AlphaMode::Blend => Some("BLEND"),
+    };
+    if let Some(mode) = alpha {
+        desc.warnings.push(format!("{}: {field}.alphaMode {mode} is read as OPAQUE (raylab has no alpha cut-outs or transparency)", path.display()));
+    }
+    let material = if metallic == 0.0 && roughness >= 1.0 && metallic_roughness.is_none() {
         Material::Diffuse { albedo: base_color }
     } else {
-        let diffuse = match base_color {
-            TexColor::Constant(c) => TexColor::Constant(c * (1.0 - metallic)),
-            t => t,
-        };
-        let f0 = Rgb::splat(0.04).lerp(base, metallic);
-        Material::CookTorrance { diffuse, specular: TexColor::Constant(Rgb::ONE), roughness: (roughness * roughness).max(1e-3), distribution: Distribution::Ggx, geometry: MicrofacetGeometry::Smith, f0: TexColor::Constant(f0) }
+        Material::MetallicRoughness { base_color, metallic, roughness, metallic_roughness }
     };
     let name = m.name().map_or_else(|| field.clone(), str::to_string);
     let id = desc.add_material(name, material);
@@ -197,7 +212,7 @@ fn material(path: &Path, doc: &gltf::Gltf, buffers: &[Vec<u8>], read_uri: &dyn F
         if normal.scale() != 1.0 {
             desc.warnings.push(format!("{}: {nfield}: scale {} is read as 1", path.display(), normal.scale()));
         }
-        let tex = image_texture(path, buffers, read_uri, normal.texture(), false, &nfield)?;
+        let tex = image_texture(path, buffers, read_uri, normal.texture(), false, Rgb::ONE, &nfield)?;
         let texture = desc.add_texture(nfield, Texture::Image(tex));
         desc.material_perturbations[id.0 as usize] = Some(ShadingPerturbation::NormalMap { texture, space: NormalSpace::Tangent });
     }

@@ -13,7 +13,7 @@ use raylab_render::shape::{PatchSurfaces, DEFAULT_SEED_GRID};
 use raylab_render::shape::Sphere;
 use raylab_render::texture::{Checker, CheckerSpace, Filter, ImageTexture, Noise, NoiseKind, Wrap};
 use raylab_render::settings::{SettingKind, SettingValue, SETTINGS};
-use raylab_render::{Background, Light, Material, MaterialId, Scene, Texture, TriangleMesh};
+use raylab_render::{Background, Light, Material, MaterialId, Scene, Texture, TextureId, TriangleMesh};
 pub use raylab_render::Overrides;
 
 use crate::description::{CameraDescription, SceneDescription, Span};
@@ -33,7 +33,7 @@ const BACKGROUND: &[&str] = &["color", "texture"];
 const TEXTURE: &[&str] = &["name", "type", "file", "wrap", "filter", "srgb", "scale", "even", "odd", "space", "kind", "colors", "octaves", "seed", "color"];
 const MATERIAL: &[&str] = &[
     "name", "type", "albedo", "ka", "kd", "ks", "exponent", "reflectance", "ior", "diffuse", "specular", "roughness", "distribution", "geometry", "f0", "metal", "eta", "k", "color",
-    "normal_map", "normal_space", "bump_map", "bump_scale",
+    "base_color", "metallic", "metallic_roughness", "normal_map", "normal_space", "bump_map", "bump_scale",
 ];
 /// Fields every material kind has.
 const MATERIAL_COMMON: &[&str] = &["name", "type", "normal_map", "normal_space", "bump_map", "bump_scale"];
@@ -248,6 +248,15 @@ impl Builder<'_> {
         Ok(())
     }
 
+    /// A texture holding data rather than colour (`srgb = false`), by name.
+    fn data_texture(&self, v: &Val, key: &str, holds: &str) -> Result<TextureId, LoadError> {
+        match self.tex_color(v)? {
+            TexColor::Texture(id) if self.srgb_textures.contains(&id) => Err(v.err(format!("texture `{}` is decoded from sRGB, but `{key}` {holds}: give it `srgb = false`", v.str()?))),
+            TexColor::Texture(id) => Ok(id),
+            TexColor::Constant(_) => Err(v.err("must name a texture")),
+        }
+    }
+
     /// A colour parameter: a colour, or the name of a texture.
     fn tex_color(&self, v: &Val) -> Result<TexColor, LoadError> {
         if let Ok(name) = v.str() {
@@ -266,7 +275,7 @@ impl Builder<'_> {
         if self.material_ids.contains_key(&name) {
             return Err(name_v.err(format!("a material named `{name}` already exists")));
         }
-        let kind = t.type_name(&["diffuse", "phong", "mirror", "dielectric", "cooktorrance", "conductor", "hair"])?;
+        let kind = t.type_name(&["diffuse", "phong", "mirror", "dielectric", "cooktorrance", "conductor", "hair", "metallic-roughness"])?;
         let valid: &[&str] = match kind {
             "diffuse" => &["albedo"],
             "phong" => &["ka", "kd", "ks", "exponent"],
@@ -274,6 +283,7 @@ impl Builder<'_> {
             "cooktorrance" => &["diffuse", "specular", "roughness", "distribution", "geometry", "f0"],
             "conductor" => &["metal", "eta", "k", "roughness", "distribution", "geometry"],
             "hair" => &["color", "kd", "ks", "exponent"],
+            "metallic-roughness" => &["base_color", "metallic", "roughness", "metallic_roughness"],
             _ => &["ior"],
         };
         for k in MATERIAL {
@@ -319,6 +329,12 @@ impl Builder<'_> {
                 kd: t.opt("kd", |v| in_range_f32(v, v.f32()?, 0.0, 1.0))?.unwrap_or(0.8),
                 ks: t.opt("ks", |v| in_range_f32(v, v.f32()?, 0.0, 1.0))?.unwrap_or(0.2),
                 exponent: t.opt("exponent", |v| in_range_f32(v, v.f32()?, 0.0, 10000.0))?.unwrap_or(40.0),
+            },
+            "metallic-roughness" => Material::MetallicRoughness {
+                base_color: color("base_color", Rgb::ONE)?,
+                metallic: t.opt("metallic", |v| in_range_f32(v, v.f32()?, 0.0, 1.0))?.unwrap_or(1.0),
+                roughness: t.opt("roughness", |v| in_range_f32(v, v.f32()?, 0.0, 1.0))?.unwrap_or(1.0),
+                metallic_roughness: t.get("metallic_roughness").map(|v| self.data_texture(&v, "metallic_roughness", "holds metalness and roughness")).transpose()?,
             },
             _ => Material::Dielectric { ior: t.opt("ior", |v| positive(v, v.f32()?))?.unwrap_or(1.5) },
         };

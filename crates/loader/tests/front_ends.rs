@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use raylab_core::{Rgb, Vec3};
 use raylab_loader::{load_scene_or_mesh, load_scene_str, Overrides};
 use raylab_loader::files::Resolver;
-use raylab_render::{IntegratorKind, SamplerKind, Scene};
+use raylab_render::material::TexColor;
+use raylab_render::{IntegratorKind, Material, SamplerKind, Scene};
 
 fn data() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data")
@@ -212,15 +213,80 @@ fn gltf_nodes_camera_light_and_material_map_as_documented() {
     assert!(matches!(s.lights[0], raylab_render::Light::Point { position, intensity } if position == Vec3::new(0.0, 3.0, 0.0) && intensity == Rgb::new(10.0, 5.0, 2.5)));
     let m = s.geometry.meshes[0].material;
     assert_eq!(s.material_names[m.0 as usize], "gold-ish");
-    // Fully metallic: no diffuse, f0 = base colour, α = roughness².
-    match &s.materials[m.0 as usize] {
-        raylab_render::Material::CookTorrance { diffuse, f0, roughness, .. } => {
-            assert_eq!(*diffuse, raylab_render::material::TexColor::Constant(Rgb::ZERO));
-            assert_eq!(*f0, raylab_render::material::TexColor::Constant(Rgb::new(1.0, 0.8, 0.4)));
-            assert_eq!(*roughness, 0.25);
+    // glTF's own BRDF: fully metallic, so no diffuse, f0 = base colour, α = roughness².
+    let mat = &s.materials[m.0 as usize];
+    assert_eq!(*mat, Material::MetallicRoughness { base_color: TexColor::Constant(Rgb::new(1.0, 0.8, 0.4)), metallic: 1.0, roughness: 0.5, metallic_roughness: None });
+    assert_cook_torrance(mat.bsdf(&s.textures, raylab_core::Vec2::ZERO, Vec3::ZERO), Rgb::ZERO, Rgb::new(1.0, 0.8, 0.4), 0.25);
+}
+
+/// The BSDF is glTF's: Cook–Torrance with GGX–Smith, Schlick's Fresnel from `f0`, and the
+/// given diffuse colour and α.
+fn assert_cook_torrance(bsdf: raylab_render::bsdf::Bsdf, diffuse: Rgb, f0: Rgb, alpha: f32) {
+    use raylab_render::bsdf::{Bsdf, Distribution, Fresnel, Geometry};
+    match bsdf {
+        Bsdf::CookTorrance { diffuse: d, specular, alpha: a, distribution: Distribution::Ggx, geometry: Geometry::Smith, fresnel: Fresnel::Schlick(f) } => {
+            assert!((d - diffuse).abs().max_element() < 1e-6, "diffuse {d} vs {diffuse}");
+            assert!((f - f0).abs().max_element() < 1e-6, "f0 {f} vs {f0}");
+            assert!((a - alpha).abs() < 1e-6, "alpha {a} vs {alpha}");
+            assert_eq!(specular, Rgb::ONE);
         }
         other => panic!("{other:?}"),
     }
+}
+
+/// A metallic-roughness texture (linear data: green = roughness, blue = metalness) scales the
+/// factors per shading point; the base-colour factor multiplies the base-colour texture; an
+/// occlusion texture and alpha masks are ignored with a warning.
+#[test]
+fn gltf_metallic_roughness_textures_vary_the_brdf_per_point() {
+    let dir = std::env::temp_dir().join(format!("raylab_gltf_mr_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let positions: Vec<u8> = [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    let uvs: Vec<u8> = [[0f32, 1.0], [1.0, 1.0], [0.0, 0.0]].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    let buffer = base64::encode([positions, uvs].concat());
+    // Red (occlusion in packed ORM textures) 255, roughness 102/255 = 0.4, metalness 51/255 = 0.2.
+    let (orm, colour) = (base64::encode(png_1x1([255, 102, 51])), base64::encode(png_1x1([188, 188, 188])));
+    let json = format!(
+        r#"{{
+      "asset": {{"version": "2.0"}},
+      "scenes": [{{"nodes": [0]}}],
+      "nodes": [{{"mesh": 0}}],
+      "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}, "material": 0}}]}}],
+      "materials": [{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}, "baseColorFactor": [1, 0.5, 0.25, 1],
+                      "metallicRoughnessTexture": {{"index": 1}}, "metallicFactor": 1, "roughnessFactor": 0.5}},
+                     "occlusionTexture": {{"index": 1}}, "alphaMode": "MASK"}}],
+      "textures": [{{"source": 0}}, {{"source": 1}}],
+      "images": [{{"uri": "data:image/png;base64,{colour}"}}, {{"uri": "data:image/png;base64,{orm}"}}],
+      "buffers": [{{"uri": "data:application/octet-stream;base64,{buffer}", "byteLength": 60}}],
+      "bufferViews": [{{"buffer": 0, "byteLength": 36}}, {{"buffer": 0, "byteOffset": 36, "byteLength": 24}}],
+      "accessors": [
+        {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}},
+        {{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}}
+      ]
+    }}"#
+    );
+    let path = dir.join("orm.gltf");
+    std::fs::write(&path, &json).unwrap();
+    let desc = raylab_loader::parse_any(&path, false).unwrap_or_else(|e| panic!("{e}"));
+    let p = path.display();
+    assert_eq!(
+        desc.warnings,
+        vec![
+            format!("{p}: materials[0].occlusionTexture is ignored (the path tracer computes occlusion)"),
+            format!("{p}: materials[0].alphaMode MASK is read as OPAQUE (raylab has no alpha cut-outs or transparency)"),
+        ]
+    );
+    let s = raylab_loader::build_scene(desc, &Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
+    std::fs::remove_dir_all(&dir).ok();
+    let m = &s.materials[s.geometry.meshes[0].material.0 as usize];
+    let Material::MetallicRoughness { metallic, roughness, metallic_roughness: Some(_), .. } = m else { panic!("{m:?}") };
+    assert_eq!((*metallic, *roughness), (1.0, 0.5));
+    // Texel values by hand: base = sRGB 188 (linear 0.50289) × factor; metalness 1 × 0.2;
+    // roughness 0.5 × 0.4 = 0.2, α = 0.04; diffuse = base·(1 - 0.2); f0 = 0.04 + (base - 0.04)·0.2.
+    // The data texture is read linear: decoded as sRGB, 102 would be 0.133, not 0.4.
+    let base = Rgb::new(1.0, 0.5, 0.25) * 0.502886;
+    let bsdf = m.bsdf(&s.textures, raylab_core::Vec2::new(0.3, 0.3), Vec3::ZERO);
+    assert_cook_torrance(bsdf, base * 0.8, Rgb::splat(0.04) + (base - Rgb::splat(0.04)) * 0.2, 0.04);
 }
 
 /// A 1×1 PNG of one 8-bit colour, as exporters embed images.

@@ -176,6 +176,27 @@ fn normal_and_bump_map_errors() {
     assert_eq!(srgb, "bad.toml:12: materials[0].normal_map: texture `nm` is decoded from sRGB, but a normal map holds linear vectors: give it `srgb = false`");
 }
 
+/// glTF's metallic-roughness material in TOML: the texture holds data (read linear), the
+/// factors are fractions.
+#[test]
+fn metallic_roughness_materials_load_and_check_their_fields() {
+    let textures = "[[textures]]\nname = \"srgb\"\ntype = \"image\"\nfile = \"textures/grass_normal_1024.jpg\"\n\
+                    [[textures]]\nname = \"orm\"\ntype = \"image\"\nfile = \"textures/grass_normal_1024.jpg\"\nsrgb = false\n";
+    let material = |fields: &str| format!("{CAMERA}{textures}[[materials]]\nname = \"m\"\ntype = \"metallic-roughness\"\n{fields}");
+    assert_eq!(error_of(&material("metallic_roughness = \"srgb\"\n")), "bad.toml:17: materials[0].metallic_roughness: texture `srgb` is decoded from sRGB, but `metallic_roughness` holds metalness and roughness: give it `srgb = false`");
+    assert_eq!(error_of(&material("metallic_roughness = [1, 1, 1]\n")), "bad.toml:17: materials[0].metallic_roughness: must name a texture");
+    assert_eq!(error_of(&material("roughness = 1.5\n")), "bad.toml:17: materials[0].roughness: must be between 0 and 1, found 1.5");
+    assert_eq!(
+        error_of(&material("ior = 1.5\n")),
+        "bad.toml:17: materials[0].ior: not a field of `metallic-roughness` materials (valid: name, type, normal_map, normal_space, bump_map, bump_scale, base_color, metallic, roughness, metallic_roughness)"
+    );
+    let src = material("base_color = [0.9, 0.6, 0.2]\nmetallic = 0.25\nroughness = 0.5\nmetallic_roughness = \"orm\"\n");
+    let scene = load_scene_str(&src, Path::new("ok.toml"), &Resolver::Disk { base: fixtures() }, &Overrides::default()).unwrap();
+    use raylab_render::material::TexColor;
+    use raylab_render::{Material, TextureId};
+    assert_eq!(scene.materials[1], Material::MetallicRoughness { base_color: TexColor::Constant(raylab_core::Rgb::new(0.9, 0.6, 0.2)), metallic: 0.25, roughness: 0.5, metallic_roughness: Some(TextureId(1)) });
+}
+
 #[test]
 fn normal_and_bump_maps_load() {
     let src = format!(

@@ -43,7 +43,7 @@ pub(super) fn radiance(scene: &Scene, ray: &Ray, depth: u32, sampler: &mut Pixel
                     kd + ks * (spec / cos)
                 })
         }
-        m @ (Material::CookTorrance { .. } | Material::Conductor { .. }) => {
+        m @ (Material::CookTorrance { .. } | Material::Conductor { .. } | Material::MetallicRoughness { .. }) => {
             // Microfacet reflection of the delta lights, by the physically based BSDF.
             let bsdf = m.bsdf(tex, g.uv, g.p);
             let frame = Frame::from_z(facing(g.ns, wo));

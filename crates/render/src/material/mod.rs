@@ -58,6 +58,13 @@ pub enum Material {
     /// Kajiya–Kay hair along the surface's tangent `dpdu` (curves, tubes):
     /// `f = (color·kd·sin(T, ωi) + ks·cos^exponent θ') / π` (see `crate::bsdf`).
     Hair { color: TexColor, kd: f32, ks: f32, exponent: f32 },
+    /// glTF 2.0's metallic-roughness material (also Blender's Principled BSDF without its
+    /// extra lobes): base colour `b = base_color`, metalness `m = metallic · B` and perceptual
+    /// roughness `r = roughness · G`, where B and G are the blue and green channels of the
+    /// linear `metallic_roughness` texture (1 without one). It is the Cook–Torrance BRDF with
+    /// diffuse `b·(1 − m)`, Schlick `f0 = lerp(0.04, b, m)` and GGX–Smith `α = r²`, per
+    /// shading point, so that textured metalness and roughness vary across the surface.
+    MetallicRoughness { base_color: TexColor, metallic: f32, roughness: f32, metallic_roughness: Option<TextureId> },
 }
 
 /// Complex refractive indices `(eta, k)` of common metals at the R, G and B primaries
@@ -86,6 +93,18 @@ impl Material {
                 Bsdf::CookTorrance { diffuse: Rgb::ZERO, specular: Rgb::ONE, alpha: *roughness, distribution: *distribution, geometry: *geometry, fresnel: Fresnel::Conductor { eta: *eta, k: *k } }
             }
             Material::Hair { color, kd, ks, exponent } => Bsdf::KajiyaKay { color: c(color), kd: *kd, ks: *ks, exponent: *exponent },
+            Material::MetallicRoughness { base_color, metallic, roughness, metallic_roughness } => {
+                let base = c(base_color);
+                let (m, r) = metallic_roughness_at(*metallic, *roughness, metallic_roughness.map(|t| c(&TexColor::Texture(t))));
+                Bsdf::CookTorrance {
+                    diffuse: base * (1.0 - m),
+                    specular: Rgb::ONE,
+                    alpha: (r * r).max(MIN_ALPHA),
+                    distribution: Distribution::Ggx,
+                    geometry: MicrofacetGeometry::Smith,
+                    fresnel: Fresnel::Schlick(Rgb::splat(0.04).lerp(base, m)),
+                }
+            }
         }
     }
 
@@ -100,6 +119,7 @@ impl Material {
             Material::CookTorrance { diffuse, specular, .. } => c(diffuse) + c(specular),
             Material::Conductor { eta, k, .. } => Fresnel::Conductor { eta: *eta, k: *k }.eval(1.0),
             Material::Hair { color, .. } => c(color),
+            Material::MetallicRoughness { base_color, .. } => c(base_color),
         }
     }
 
@@ -116,6 +136,18 @@ impl Material {
             Material::CookTorrance { .. } => "cooktorrance",
             Material::Conductor { .. } => "conductor",
             Material::Hair { .. } => "hair",
+            Material::MetallicRoughness { .. } => "metallic-roughness",
         }
     }
+}
+
+/// The smallest GGX α a metallic-roughness material gets: roughness 0 would be a mirror,
+/// which the microfacet lobe cannot sample (as glTF viewers clamp it).
+pub const MIN_ALPHA: f32 = 1e-3;
+
+/// Metalness and perceptual roughness at a point: the factors times the texture's blue
+/// (metalness) and green (roughness) channels, as glTF packs them, clamped to [0, 1].
+pub fn metallic_roughness_at(metallic: f32, roughness: f32, texel: Option<Rgb>) -> (f32, f32) {
+    let t = texel.unwrap_or(Rgb::ONE);
+    ((metallic * t.z).clamp(0.0, 1.0), (roughness * t.y).clamp(0.0, 1.0))
 }
