@@ -12,11 +12,8 @@ pub fn settings(desc: &SceneDescription, overrides: &Overrides) -> Result<Render
     let mut s = RenderSettings::default();
     desc.settings.apply(&mut s);
     overrides.apply(&mut s);
-    if let Some(n) = jittered_strata(s.sampler, s.spp) {
-        // Stratification needs n × n samples: round up, as Mitsuba's stratified sampler does,
-        // and say so once rather than fail.
-        eprintln!("note: the jittered sampler stratifies {n}×{n}: {} samples per pixel rounded up to {}", s.spp, n * n);
-        s.spp = n * n;
+    if let Some(note) = round_up_jittered_spp(&mut s) {
+        eprintln!("note: {note}");
     }
     if let Err(e) = s.sampler.check_spp(s.spp) {
         return Err(match (overrides.spp, &desc.spp_span) {
@@ -26,6 +23,16 @@ pub fn settings(desc: &SceneDescription, overrides: &Overrides) -> Result<Render
         });
     }
     Ok(s)
+}
+
+/// Stratification needs n × n samples: a non-square `spp` with the jittered sampler is
+/// rounded up, as Mitsuba's stratified sampler does, and said once rather than failed.
+/// Returns what to say, when it rounded.
+pub fn round_up_jittered_spp(s: &mut RenderSettings) -> Option<String> {
+    let n = jittered_strata(s.sampler, s.spp)?;
+    let note = format!("the jittered sampler stratifies {n}×{n}: {} samples per pixel rounded up to {}", s.spp, n * n);
+    s.spp = n * n;
+    Some(note)
 }
 
 /// The side of the square grid of strata a non-square `spp` is rounded up to, for the

@@ -42,6 +42,12 @@ pub fn to_py<T: serde::Serialize>(py: Python<'_>, v: &T) -> PyResult<Py<PyAny>> 
     json_to_py(py, &json)
 }
 
+/// One value per pixel as an `(H, W)` float32 array, non-finite values as 0.
+pub fn scalar_array<'py>(py: Python<'py>, width: u32, height: u32, values: &[f32]) -> PyResult<Bound<'py, PyAny>> {
+    let flat: Vec<f32> = values.iter().map(|&v| if v.is_finite() { v } else { 0.0 }).collect();
+    Ok(PyArray1::from_vec(py, flat).reshape([height as usize, width as usize])?.into_any())
+}
+
 /// An image as an `(H, W, 3)` float32 array, row 0 at the top, with the values the PFM
 /// writer stores (non-finite values become 0, as there).
 pub fn image_array<'py>(py: Python<'py>, width: u32, height: u32, pixels: &[Rgb]) -> PyResult<Bound<'py, PyAny>> {

@@ -10,9 +10,10 @@ use pyo3::types::PyDict;
 use raylab_accel::{Accel, Primitives};
 use raylab_loader::Overrides;
 use raylab_render::settings::{SettingValue, SETTINGS};
+use raylab_render::film::image_out::Aov;
 use raylab_render::{IntegratorKind, RenderOutput, Scene as RScene};
 
-use crate::convert::{image_array, to_py};
+use crate::convert::{image_array, scalar_array, to_py};
 use crate::errors::load_error;
 use crate::settings::{self, Settings};
 use crate::structure::{bounds_tuple, trace_dict, triangle_arrays};
@@ -36,8 +37,29 @@ pub fn render_interruptible(py: Python<'_>, scene: Arc<RScene>, threads: Option<
     out.ok_or_else(|| pyo3::exceptions::PyKeyboardInterrupt::new_err("render cancelled"))
 }
 
-/// The AOVs `Scene.render(aovs=...)` accepts: integrators that write one value per pixel.
-const AOVS: &[IntegratorKind] = &[IntegratorKind::Normals, IntegratorKind::Albedo, IntegratorKind::Depth, IntegratorKind::Heatmap, IntegratorKind::HeatmapTests];
+/// An AOV `Scene.render(aovs=...)` accepts: the CLI's `--aovs` and the two heat maps.
+#[derive(Clone, Copy)]
+enum PyAov {
+    /// Rendered by its own integrator.
+    Integrator(IntegratorKind),
+    /// The beauty render's per-pixel variance of luminance.
+    Variance,
+}
+
+/// The valid AOV names, as the CLI's `--aovs` spells them, then the heat maps.
+const AOV_NAMES: &str = "albedo, normal, depth, variance, heatmap, heatmap-tests";
+
+/// An AOV by name; `normals` (the integrator's name, and this module's before the CLI had
+/// `--aovs`) stays an alias of `normal`.
+fn parse_aov(name: &str) -> PyResult<PyAov> {
+    let aov = match name {
+        "normals" => Some(PyAov::Integrator(IntegratorKind::Normals)),
+        "heatmap" => Some(PyAov::Integrator(IntegratorKind::Heatmap)),
+        "heatmap-tests" => Some(PyAov::Integrator(IntegratorKind::HeatmapTests)),
+        _ => name.parse::<Aov>().ok().map(|a| a.integrator().map_or(PyAov::Variance, PyAov::Integrator)),
+    };
+    aov.ok_or_else(|| PyValueError::new_err(format!("aovs: unknown AOV `{name}` (valid: {AOV_NAMES})")))
+}
 
 /// A scene loaded from a file (any format raylab reads), or the default scene.
 ///
@@ -131,6 +153,10 @@ impl Scene {
         } else {
             let mut s = self.inner.settings.clone();
             n.apply(&mut s);
+            // As on load (and in the CLI): a non-square count is rounded up for the jittered sampler.
+            if let Some(note) = raylab_loader::build::round_up_jittered_spp(&mut s) {
+                eprintln!("note: {note}");
+            }
             s.sampler.check_spp(s.spp).map_err(|e| PyValueError::new_err(format!("spp: {e}")))?;
             let rebuild = n.accel.is_some_and(|k| k != self.inner.settings.accel);
             let pool = settings::pool(threads)?;
@@ -209,32 +235,29 @@ impl Scene {
     }
 
     /// Renders with the current settings. Returns the image as an (H, W, 3) float32 array
-    /// of linear radiance, row 0 at the top; with `aovs` (any of "normals", "albedo",
-    /// "depth", "heatmap", "heatmap-tests"), a dict with "image" and one array per AOV.
+    /// of linear radiance, row 0 at the top; with `aovs` (any of "albedo", "normal",
+    /// "depth", "variance", "heatmap", "heatmap-tests"; "normals" is an alias of "normal"), a
+    /// dict with "image" and one array per AOV under the name given: (H, W, 3), and (H, W)
+    /// for "variance".
     /// The GIL is released while rendering; Ctrl-C raises KeyboardInterrupt.
     #[pyo3(signature = (*, aovs=None, threads=None))]
     fn render<'py>(&mut self, py: Python<'py>, aovs: Option<Vec<String>>, threads: Option<u32>) -> PyResult<Bound<'py, PyAny>> {
         let threads = threads.or(self.settings.threads);
-        let kinds = aovs
-            .as_ref()
-            .map(|names| {
-                names
-                    .iter()
-                    .map(|n| match n.parse::<IntegratorKind>() {
-                        Ok(k) if AOVS.contains(&k) => Ok(k),
-                        _ => Err(PyValueError::new_err(format!("aovs: unknown AOV `{n}` (valid: {})", AOVS.iter().map(|k| k.name()).collect::<Vec<_>>().join(", ")))),
-                    })
-                    .collect::<PyResult<Vec<_>>>()
-            })
-            .transpose()?;
+        let kinds = aovs.as_ref().map(|names| names.iter().map(|n| parse_aov(n)).collect::<PyResult<Vec<_>>>()).transpose()?;
         let out = self.render_with(py, None, threads)?;
         let image = image_array(py, out.width, out.height, &out.pixels)?;
         let Some(kinds) = kinds else { return Ok(image) };
         let d = PyDict::new(py);
         d.set_item("image", image)?;
         for (k, name) in kinds.iter().zip(aovs.iter().flatten()) {
-            let o = self.render_with(py, Some(*k), threads)?;
-            d.set_item(name, image_array(py, o.width, o.height, &o.pixels)?)?;
+            let array = match *k {
+                PyAov::Integrator(kind) => {
+                    let o = self.render_with(py, Some(kind), threads)?;
+                    image_array(py, o.width, o.height, &o.pixels)?
+                }
+                PyAov::Variance => scalar_array(py, out.width, out.height, &out.variance)?,
+            };
+            d.set_item(name, array)?;
         }
         Ok(d.into_any())
     }

@@ -54,22 +54,41 @@ def test_scene_render_equals_module_render_and_settings_change(repo):
     s.set(width=30, accel="grid")
     assert s.settings["accel"] == "grid" and s.accel_stats["name"] == "grid"
     np.testing.assert_array_equal(s.render(), raylab.render(repo / "scenes/cube.toml", width=30, height=18, spp=4, seed=3, accel="grid"))
-    with pytest.raises(ValueError, match=r"^spp: the jittered sampler needs a square number of samples \(1, 4, 9, 16, \.\.\.\), found 5$"):
-        s.set(spp=5)
+    # As in the CLI, a non-square count is rounded up to the next square for the jittered sampler.
+    s.set(spp=5, sampler="jittered")
+    assert s.settings["spp"] == 9
 
 
 def test_aovs(repo):
-    s = raylab.Scene(repo / "scenes/cube.toml", width=16, height=12, spp=1)
-    out = s.render(aovs=["normals", "depth", "albedo"])
-    assert set(out) == {"image", "normals", "depth", "albedo"}
-    for v in out.values():
-        assert v.shape == (12, 16, 3) and v.dtype == np.float32
-    np.testing.assert_array_equal(out["depth"], raylab.render(repo / "scenes/cube.toml", width=16, height=12, spp=1, integrator="depth"))
+    s = raylab.Scene(repo / "scenes/cube.toml", width=16, height=12, spp=4)
+    out = s.render(aovs=["normal", "depth", "albedo", "variance"])
+    assert set(out) == {"image", "normal", "depth", "albedo", "variance"}
+    for name in ("image", "normal", "depth", "albedo"):
+        assert out[name].shape == (12, 16, 3) and out[name].dtype == np.float32
+    np.testing.assert_array_equal(out["depth"], raylab.render(repo / "scenes/cube.toml", width=16, height=12, spp=4, integrator="depth"))
+    # `normals` (the integrator's name) stays an alias of the CLI's `normal`.
+    np.testing.assert_array_equal(s.render(aovs=["normals"])["normals"], out["normal"])
     # The scene's own integrator is back after the AOVs.
     assert s.settings["integrator"] == "whitted"
     np.testing.assert_array_equal(out["image"], s.render())
-    with pytest.raises(ValueError, match=r"^aovs: unknown AOV `path` \(valid: normals, albedo, depth, heatmap, heatmap-tests\)$"):
+    with pytest.raises(ValueError, match=r"^aovs: unknown AOV `path` \(valid: albedo, normal, depth, variance, heatmap, heatmap-tests\)$"):
         s.render(aovs=["path"])
+
+
+def test_variance_aov(repo):
+    """The beauty render's per-pixel variance of luminance: 0 where every sample sees the
+    same flat background, positive where samples straddle a silhouette."""
+    s = raylab.Scene(repo / "scenes/spheres_phong.toml", width=16, height=12, spp=4, seed=7)
+    out = s.render(aovs=["variance"])
+    var = out["variance"]
+    assert var.shape == (12, 16) and var.dtype == np.float32
+    lum = out["image"] @ np.array([0.2126, 0.7152, 0.0722], dtype=np.float32)
+    flat = np.isclose(lum, lum[0, 0]) & (var == 0)
+    assert flat[0, 0], "the top-left pixel sees only the background"
+    # Samples are >= 0, so each is at most 4x its pixel's mean L; the unbiased sample variance
+    # of n values in [0, 4L] is at most n/(n-1) (4L)^2/4, and divided by n: (4L)^2/12.
+    bound = 16 * lum**2 / 12
+    assert var.max() > 0 and (var <= bound * (1 + 1e-5)).all()
 
 
 def test_scene_inspection_equals_cli_inspect(cli, repo):

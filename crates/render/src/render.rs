@@ -31,6 +31,9 @@ pub struct RenderOutput {
     pub height: u32,
     /// Linear RGB, row-major, row 0 at the top.
     pub pixels: Vec<Rgb>,
+    /// Per pixel, the variance of its estimate of luminance (sample variance / samples): the
+    /// `variance` AOV.
+    pub variance: Vec<f32>,
     pub counters: Counters,
     /// Samples that came out NaN or infinite and were dropped (counted, never averaged in).
     pub nonfinite_samples: u64,
@@ -208,7 +211,7 @@ pub fn render(scene: &Scene, progress: &(dyn Fn(u64) + Sync)) -> RenderOutput {
 pub fn render_until(scene: &Scene, progress: &(dyn Fn(u64) + Sync), cancel: &AtomicBool) -> Option<RenderOutput> {
     let s = &scene.settings;
     let start = Instant::now();
-    let empty = || RenderOutput { width: s.width, height: s.height, pixels: vec![Rgb::ZERO; s.width as usize * s.height as usize], counters: Counters::default(), nonfinite_samples: 0, seconds: 0.0 };
+    let empty = || RenderOutput { width: s.width, height: s.height, pixels: vec![Rgb::ZERO; s.width as usize * s.height as usize], variance: vec![0.0; s.width as usize * s.height as usize], counters: Counters::default(), nonfinite_samples: 0, seconds: 0.0 };
     let header = memory_film_header(scene, DEFAULT_PASS_SAMPLES);
     // An empty image or no samples (settings the loader never produces): nothing to render.
     let Ok(mut film) = Film::new(header, Crop::full(s.width, s.height)) else { return Some(empty()) };
@@ -219,5 +222,5 @@ pub fn render_until(scene: &Scene, progress: &(dyn Fn(u64) + Sync), cancel: &Ato
         Err(_) => return Some(empty()),
     }
     let seconds = start.elapsed().as_secs_f64();
-    Some(RenderOutput { width: s.width, height: s.height, pixels: film.resolve(), counters: film.counters, nonfinite_samples: film.nonfinite_samples, seconds })
+    Some(RenderOutput { width: s.width, height: s.height, pixels: film.resolve(), variance: film.variance(), counters: film.counters, nonfinite_samples: film.nonfinite_samples, seconds })
 }
