@@ -19,6 +19,7 @@ pub mod pbrt;
 pub mod ply;
 pub mod scene;
 mod toml_read;
+pub mod toml_write;
 
 use std::path::Path;
 

@@ -8,39 +8,21 @@ fn size(size: u32) -> Size {
     Size { size, strands: 0, segments: 0 }
 }
 
-/// The spheres of a generated scene, `(centre, radius)` in file order.
-fn spheres(toml: &str) -> Vec<(Vec3, f32)> {
-    let value = |line: &str| line.split_once('=').unwrap().1.trim().to_string();
-    let mut out = Vec::new();
-    let mut centre = None;
-    for line in toml.lines() {
-        if line.starts_with("center =") {
-            let v: Vec<f32> = value(line).trim_matches(['[', ']']).split(',').map(|s| s.trim().parse().unwrap()).collect();
-            centre = Some(Vec3::new(v[0], v[1], v[2]));
-        } else if line.starts_with("radius =") {
-            out.push((centre.take().expect("radius after centre"), value(line).parse().unwrap()));
-        }
-    }
-    out
+/// The spheres of a generated scene, `(centre, radius)` in order of generation.
+fn spheres(name: &str, n: u32) -> Vec<(Vec3, f32)> {
+    generate(name, size(n)).unwrap().scene.geometry.spheres.iter().map(|s| (s.center, s.radius)).collect()
 }
 
-/// Vertices and 1-based triangle faces of an OBJ text.
-fn obj(text: &str) -> (Vec<Vec3>, Vec<[usize; 3]>) {
-    let (mut v, mut f) = (Vec::new(), Vec::new());
-    for line in text.lines() {
-        let t: Vec<&str> = line.split_whitespace().collect();
-        match t.first() {
-            Some(&"v") => v.push(Vec3::new(t[1].parse().unwrap(), t[2].parse().unwrap(), t[3].parse().unwrap())),
-            Some(&"f") => f.push([t[1].parse().unwrap(), t[2].parse().unwrap(), t[3].parse().unwrap()]),
-            _ => {}
-        }
-    }
-    (v, f)
+/// Vertices and 0-based triangles of the generated scene's first mesh (the floor is last).
+fn mesh(name: &str, n: u32) -> (Vec<Vec3>, Vec<[usize; 3]>) {
+    let g = generate(name, size(n)).unwrap();
+    let m = &g.scene.geometry.meshes[0];
+    (m.positions.clone(), m.indices.iter().map(|t| t.map(|k| k as usize)).collect())
 }
 
 #[test]
 fn sphereflake_children_touch_their_parent() {
-    let s = spheres(&generate("balls", size(1), "").unwrap().toml);
+    let s = spheres("balls", 1);
     assert_eq!(s.len(), 10);
     assert_eq!(s[0], (Vec3::ZERO, 1.0));
     // Nine children of radius 1/3 resting on the unit sphere: centres at 1 + 1/3 from the origin;
@@ -64,7 +46,7 @@ fn sphereflake_children_touch_their_parent() {
         }
     }
     // Depth 2: every grandchild (radius 1/9) touches one child.
-    let s = spheres(&generate("balls", size(2), "").unwrap().toml);
+    let s = spheres("balls", 2);
     let (kids, grandkids): (Vec<_>, Vec<_>) = s[1..].iter().partition(|(_, r)| (r - 1.0 / 3.0).abs() < 1e-6);
     assert_eq!((kids.len(), grandkids.len()), (9, 81));
     for (g, r) in &grandkids {
@@ -75,7 +57,7 @@ fn sphereflake_children_touch_their_parent() {
 
 #[test]
 fn rings_sit_on_their_circles() {
-    let s = spheres(&generate("rings", size(3), "").unwrap().toml);
+    let s = spheres("rings", 3);
     assert_eq!(s.len(), 12 + 24 + 36);
     // Ring i: 12i spheres of radius π·2i/(12i) = π/6 on the circle of radius 2i, lifted to r + 0.2i.
     let mut start = 0;
@@ -94,18 +76,17 @@ fn rings_sit_on_their_circles() {
 #[test]
 fn sierpinski_tetrahedron_keeps_its_surface_area_and_bounds() {
     for depth in 1..=3 {
-        let g = generate("tetra", size(depth), "t.obj").unwrap();
-        let (v, f) = obj(&g.side_file.unwrap());
+        let (v, f) = mesh("tetra", depth);
         assert_eq!(f.len(), 4usize.pow(depth + 1));
         // Each level halves the edges and quadruples the tetrahedra: the total area stays that
         // of the unit-corner tetrahedron, 4 · (√3/4)(2√2)² = 8√3.
-        let area: f32 = f.iter().map(|t| 0.5 * (v[t[1] - 1] - v[t[0] - 1]).cross(v[t[2] - 1] - v[t[0] - 1]).length()).sum();
+        let area: f32 = f.iter().map(|t| 0.5 * (v[t[1]] - v[t[0]]).cross(v[t[2]] - v[t[0]]).length()).sum();
         assert!((area - 8.0 * 3f32.sqrt()).abs() < 1e-3, "depth {depth}: area {area}");
         // Every edge is 2√2 / 2^depth long and every vertex inside the corners' cube [−1, 1]³.
         let edge = 2.0 * 2f32.sqrt() / (1 << depth) as f32;
         for t in &f {
             for k in 0..3 {
-                assert!((v[t[k] - 1].distance(v[t[(k + 1) % 3] - 1]) - edge).abs() < 1e-5);
+                assert!((v[t[k]].distance(v[t[(k + 1) % 3]]) - edge).abs() < 1e-5);
             }
         }
         assert!(v.iter().all(|p| p.abs().max_element() <= 1.0 + 1e-6));
@@ -114,8 +95,7 @@ fn sierpinski_tetrahedron_keeps_its_surface_area_and_bounds() {
 
 #[test]
 fn mountain_is_a_height_field_over_the_square_facing_up() {
-    let g = generate("mount", size(3), "m.obj").unwrap();
-    let (v, f) = obj(&g.side_file.unwrap());
+    let (v, f) = mesh("mount", 3);
     let n = 8;
     assert_eq!((v.len(), f.len()), ((n + 1) * (n + 1), 2 * n * n));
     // Grid vertices at x, z = −2 + 4i/n; the ground projection of the triangles tiles the 4 × 4 square.
@@ -126,42 +106,39 @@ fn mountain_is_a_height_field_over_the_square_facing_up() {
     }
     let mut projected = 0.0;
     for t in &f {
-        let normal = (v[t[1] - 1] - v[t[0] - 1]).cross(v[t[2] - 1] - v[t[0] - 1]);
+        let normal = (v[t[1]] - v[t[0]]).cross(v[t[2]] - v[t[0]]);
         assert!(normal.y > 0.0, "face {t:?} faces down");
         projected += 0.5 * normal.y;
     }
     assert!((projected - 16.0f32).abs() < 1e-4, "{projected}");
     // The four spheres (radius 0.25) are in the scene as written.
-    assert_eq!(spheres(&g.toml).iter().filter(|(_, r)| *r == 0.25).count(), 4);
+    assert_eq!(spheres("mount", 3).iter().filter(|(_, r)| *r == 0.25).count(), 4);
 }
 
 #[test]
 fn hair_strands_start_inside_the_ball_and_advance_in_equal_steps() {
     let (strands, segments) = (40u32, 4u32);
-    let g = generate("hair", Size { size: 0, strands, segments }, "b.curves").unwrap();
+    let g = generate("hair", Size { size: 0, strands, segments }).unwrap();
     let step = 0.6 / segments as f32;
-    let text = g.side_file.unwrap();
-    let mut points: Vec<Vec<(Vec3, f32)>> = Vec::new();
-    for line in text.lines().filter(|l| !l.starts_with('#')) {
-        if line == "strand" {
-            points.push(Vec::new());
-            continue;
-        }
-        let x: Vec<f32> = line.split(' ').map(|s| s.parse().unwrap()).collect();
-        points.last_mut().unwrap().push((Vec3::new(x[0], x[1], x[2]), x[3]));
-    }
-    assert_eq!(points.len(), strands as usize);
-    for (k, strand) in points.iter().enumerate() {
-        // The phantom point is one step inside the ball, on the Fibonacci lattice's normal:
-        // its height is (1 − step)(1 − 2(k + ½)/strands).
-        let (p0, r0) = strand[0];
-        assert!((p0.length() - (1.0 - step)).abs() < 1e-5, "strand {k}: {p0}");
-        assert!((p0.y - (1.0 - step) * (1.0 - 2.0 * (k as f32 + 0.5) / strands as f32)).abs() < 1e-5);
-        for w in strand.windows(2) {
-            assert!((w[0].0.distance(w[1].0) - step).abs() < 1e-5, "strand {k}: uneven step");
+    let curves = &g.scene.geometry.curves;
+    assert_eq!(curves.len(), strands as usize);
+    for (k, c) in curves.iter().enumerate() {
+        assert_eq!(c.segments.len(), segments as usize);
+        // The Catmull–Rom points p1..p(segments+1) are the Bézier segments' ends; the phantom
+        // p0 comes back from the first segment, whose second control point is p1 + (p2 − p0)/6.
+        let cp = c.segments[0].control_points();
+        let phantom = cp[3].truncate() - 6.0 * (cp[1].truncate() - cp[0].truncate());
+        // It is one step inside the ball, on the Fibonacci lattice's normal: its height is
+        // (1 − step)(1 − 2(k + ½)/strands).
+        assert!((phantom.length() - (1.0 - step)).abs() < 2e-5, "strand {k}: {phantom}");
+        assert!((phantom.y - (1.0 - step) * (1.0 - 2.0 * (k as f32 + 0.5) / strands as f32)).abs() < 2e-5);
+        assert!((phantom.distance(cp[0].truncate()) - step).abs() < 2e-5, "strand {k}: uneven first step");
+        let ends: Vec<_> = c.segments.iter().map(|s| s.control_points()[0]).chain([c.segments.last().unwrap().control_points()[3]]).collect();
+        for w in ends.windows(2) {
+            assert!((w[0].truncate().distance(w[1].truncate()) - step).abs() < 1e-5, "strand {k}: uneven step");
         }
         // Radii taper from the root's to a third of it at the tip (1 − 0.67).
-        let tip = strand.last().unwrap().1;
-        assert!((tip - 0.33 * r0).abs() < 1e-6 * r0.max(1.0), "strand {k}: {r0} → {tip}");
+        let (root, tip) = (ends[0].w, ends.last().unwrap().w);
+        assert!((tip - 0.33 * root).abs() < 1e-6 * root.max(1.0), "strand {k}: {root} → {tip}");
     }
 }

@@ -180,6 +180,14 @@ macro_rules! render_settings {
                 $( if let Some(v) = self.$key { s.$key = v; } )+
             }
 
+            /// The value these overrides give the setting named `key`, if they give one.
+            pub fn get(&self, key: &str) -> Option<SettingValue<'static>> {
+                match key {
+                    $( stringify!($key) => self.$key.map(SettingType::value), )+
+                    _ => None,
+                }
+            }
+
             /// These overrides on top of `earlier`: the values these set win.
             pub fn or(&self, earlier: &Overrides) -> Overrides {
                 Overrides {

@@ -1,6 +1,6 @@
 //! `raylab gen`: procedural scenes of any size (Haines' SPD, and a furry ball of curves),
-//! written as a scene file and, for triangle-heavy or hairy scenes, an OBJ mesh or a
-//! curve file beside it.
+//! generated as scene descriptions and written by the TOML writer as a scene file and, for
+//! triangle-heavy or hairy scenes, an OBJ mesh or a curve file beside it.
 
 use std::path::PathBuf;
 
@@ -32,14 +32,16 @@ pub fn run(a: &GenArgs) -> Result<()> {
         anyhow::bail!("--output: the scene file must end in .toml (its mesh or curves are written beside it), found {}", a.output.display());
     }
     let stem = a.output.file_stem().and_then(|s| s.to_str()).context("--output: needs a file name")?;
-    let side_name = format!("{stem}.{}", if a.kind == "hair" { "curves" } else { "obj" });
     let size = raylab_procedural::Size { size: a.size, strands: a.strands, segments: a.segments };
-    let g = raylab_procedural::generate(&a.kind, size, &side_name).map_err(anyhow::Error::msg)?;
-    raylab_render::film::atomic::write_atomic(&a.output, &g.toml).with_context(|| format!("{}: cannot write", a.output.display()))?;
-    if let Some(text) = &g.side_file {
-        let side_path = a.output.with_file_name(&side_name);
-        raylab_render::film::atomic::write_atomic(&side_path, text).with_context(|| format!("{}: cannot write", side_path.display()))?;
+    let g = raylab_procedural::generate(&a.kind, size).map_err(anyhow::Error::msg)?;
+    let written = raylab_loader::toml_write::write_toml(&g.scene, stem, &g.title).map_err(|e| anyhow::anyhow!("cannot write the generated scene: {e}"))?;
+    // Side files first: a scene file never names a file that is not there yet.
+    for f in &written.side_files {
+        let path = a.output.with_file_name(&f.name);
+        raylab_render::film::atomic::write_atomic(&path, &f.contents).with_context(|| format!("{}: cannot write", path.display()))?;
     }
-    eprintln!("Wrote {} ({} spheres, {} triangles, {} curve segments).", a.output.display(), g.spheres, g.triangles, g.curve_segments);
+    raylab_render::film::atomic::write_atomic(&a.output, &written.toml).with_context(|| format!("{}: cannot write", a.output.display()))?;
+    let geometry = &g.scene.geometry;
+    eprintln!("Wrote {} ({} spheres, {} triangles, {} curve segments).", a.output.display(), geometry.spheres.len(), geometry.triangle_count(), g.curve_segments());
     Ok(())
 }
