@@ -110,3 +110,25 @@ fn sphere_roots_by_hand() {
     // A direction of length 4: t in units of it.
     assert_eq!(at(o, 4.0 * Vec3::Z, 0.0, f32::INFINITY), Some(1.0));
 }
+
+/// Where single precision rounds an edge function to exactly 0, its sign comes from double
+/// precision. Here the ray (the origin, along +z) passes outside the edge p1–p2 by about
+/// 2⁻²⁵: exactly, `cx·by − cy·bx = −(1 + 2⁻¹¹) + (1 + 2⁻¹²)² = −2⁻²⁴`, but
+/// `(1 + 2⁻¹²)²` rounds to `1 + 2⁻¹¹` (a tie, to even) and the f32 difference is 0, which
+/// alone would count as inside. Each rotation of the corners puts that edge in another of
+/// the three edge functions.
+#[test]
+fn an_edge_function_rounded_to_zero_takes_its_sign_from_double_precision() {
+    let (e11, e12) = (2f32.powi(-11), 2f32.powi(-12));
+    let (p0, p1, p2) = (v(-1.0, 1.0, 1.0), v(1.0, 1.0 + e12, 1.0), v(-(1.0 + e12), -(1.0 + e11), 1.0));
+    assert_eq!((1.0 + e12) * (1.0 + e12), 1.0 + e11, "the product this test relies on rounds");
+    let ray = Ray::new(Vec3::ZERO, Vec3::Z);
+    for (a, b, c) in [(p0, p1, p2), (p1, p2, p0), (p2, p0, p1)] {
+        assert_eq!(triangle(&ray, a, b, c), None, "{a} {b} {c}");
+    }
+    // Moved inside the edge by 2⁻²⁰ (far more than the rounding), the ray hits, in every rotation.
+    let inside = Ray::new(v(-(2f32.powi(-20)), 2f32.powi(-20), 0.0), Vec3::Z);
+    for (a, b, c) in [(p0, p1, p2), (p1, p2, p0), (p2, p0, p1)] {
+        assert_eq!(triangle(&inside, a, b, c).map(|h| h.0), Some(1.0), "{a} {b} {c}");
+    }
+}
