@@ -2,7 +2,7 @@
 //! folder of any ancestor directory (where raylab keeps its large test meshes), or, for the
 //! embedded default scene, in the binary itself.
 
-use std::io::Read;
+use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
 use crate::error::LoadError;
@@ -55,6 +55,19 @@ impl Found {
         Ok(raw)
     }
 
+    /// The file's lines, one at a time, gunzipped when the name ends in `.gz`: for a large
+    /// text (an OBJ) that is parsed as it is read rather than held whole.
+    pub fn lines(&self) -> Result<Lines, LoadError> {
+        let path = self.path();
+        let gz = path.extension().is_some_and(|e| e == "gz");
+        let raw: Box<dyn Read> = match self {
+            Found::Disk(p) => Box::new(open_checked(p, MAX_DATA_BYTES)?),
+            Found::Embedded(_, bytes) => Box::new(*bytes),
+        };
+        let inner: Box<dyn BufRead> = if gz { Box::new(BufReader::new(flate2::read::GzDecoder::new(BufReader::new(raw)))) } else { Box::new(BufReader::new(raw)) };
+        Ok(Lines { path, gz, inner, read: 0 })
+    }
+
     /// A resolver for files named inside this one (an OBJ's MTL, an MTL's textures).
     pub fn sibling_resolver(&self) -> Resolver {
         match self {
@@ -101,6 +114,28 @@ impl Resolver {
     }
 }
 
+/// A data file read a line at a time, with [`Found::read`]'s cap and messages.
+pub struct Lines {
+    path: PathBuf,
+    gz: bool,
+    inner: Box<dyn BufRead>,
+    read: u64,
+}
+
+impl Lines {
+    /// The next line into `buf` (cleared first; its end of line kept): `false` at the end.
+    pub fn next_into(&mut self, buf: &mut Vec<u8>) -> Result<bool, LoadError> {
+        buf.clear();
+        let n = self.inner.read_until(b'\n', buf).map_err(|e| LoadError::file(&self.path, format!("{}: {e}", if self.gz { "cannot decompress" } else { "cannot read" })))?;
+        self.read += n as u64;
+        if self.read > MAX_DATA_BYTES {
+            let m = if self.gz { format!("decompresses to more than {}, the most raylab reads from one file", human(MAX_DATA_BYTES)) } else { format!("more than {} (the most raylab reads from one such file): is it endless?", human(MAX_DATA_BYTES)) };
+            return Err(LoadError::file(&self.path, m));
+        }
+        Ok(n > 0)
+    }
+}
+
 /// The largest scene text (TOML, pbrt) raylab reads: a scene file is settings and names;
 /// its geometry lives in the files it names. An endless input (`/dev/zero`, a pipe that
 /// never ends) stops here with an error instead of exhausting memory.
@@ -113,6 +148,18 @@ pub const MAX_DATA_BYTES: u64 = 32 << 30;
 /// regular file larger than `cap` (or than the machine's memory, unless --allow-large) is
 /// refused before reading; a pipe is read up to `cap` bytes.
 pub fn read_capped(path: &Path, cap: u64) -> Result<Vec<u8>, LoadError> {
+    let fail = |m: String| LoadError::file(path, m);
+    let file = open_checked(path, cap)?;
+    let mut bytes = Vec::new();
+    file.take(cap + 1).read_to_end(&mut bytes).map_err(|e| fail(format!("cannot read: {e}")))?;
+    if bytes.len() as u64 > cap {
+        return Err(fail(format!("more than {} (the most raylab reads from one such file): is it endless?", human(cap))));
+    }
+    Ok(bytes)
+}
+
+/// Opens a file for reading after [`read_capped`]'s checks of its kind and size.
+fn open_checked(path: &Path, cap: u64) -> Result<std::fs::File, LoadError> {
     let fail = |m: String| LoadError::file(path, m);
     let meta = std::fs::metadata(path).map_err(|e| fail(format!("cannot read: {e}")))?;
     let kind = meta.file_type();
@@ -128,13 +175,7 @@ pub fn read_capped(path: &Path, cap: u64) -> Result<Vec<u8>, LoadError> {
         }
         raylab_render::memory_guard::check("reading it", Some(meta.len())).map_err(fail)?;
     }
-    let file = std::fs::File::open(path).map_err(|e| fail(format!("cannot read: {e}")))?;
-    let mut bytes = Vec::new();
-    file.take(cap + 1).read_to_end(&mut bytes).map_err(|e| fail(format!("cannot read: {e}")))?;
-    if bytes.len() as u64 > cap {
-        return Err(fail(format!("more than {} (the most raylab reads from one such file): is it endless?", human(cap))));
-    }
-    Ok(bytes)
+    std::fs::File::open(path).map_err(|e| fail(format!("cannot read: {e}")))
 }
 
 #[cfg(unix)]

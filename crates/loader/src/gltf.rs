@@ -16,10 +16,11 @@ use raylab_render::{Light, Material, MaterialId, Texture, TextureId, TriangleMes
 
 use crate::description::{CameraDescription, SceneDescription, Span};
 use crate::error::LoadError;
+use crate::files::{read_capped, MAX_DATA_BYTES};
 
 /// Reads a glTF or GLB file (and the buffers and images it names) into a description.
 pub fn parse_gltf(path: &Path) -> Result<SceneDescription, LoadError> {
-    let bytes = std::fs::read(path).map_err(|e| LoadError::file(path, format!("cannot read: {e}")))?;
+    let bytes = read_capped(path, MAX_DATA_BYTES)?;
     let doc = gltf::Gltf::from_slice(&bytes).map_err(|e| LoadError::file(path, format!("not a valid glTF 2.0 file: {e}")))?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let read_uri = |what: &str, uri: &str| -> Result<Vec<u8>, LoadError> {
@@ -27,7 +28,7 @@ pub fn parse_gltf(path: &Path) -> Result<SceneDescription, LoadError> {
             return data_uri(data).map_err(|e| LoadError::new(path, None, what, e));
         }
         let file = base.join(uri.replace("%20", " "));
-        std::fs::read(&file).map_err(|e| LoadError::new(path, None, what, format!("{}: cannot read: {e}", file.display())))
+        read_capped(&file, MAX_DATA_BYTES).map_err(|e| LoadError::new(path, None, what, e.to_string()))
     };
     let mut buffers = Vec::new();
     for b in doc.buffers() {
@@ -52,6 +53,13 @@ pub fn parse_gltf(path: &Path) -> Result<SceneDescription, LoadError> {
                 let pfield = format!("meshes[{}].primitives[{}]", mesh.index(), prim.index());
                 if prim.mode() != gltf::mesh::Mode::Triangles {
                     return Err(LoadError::new(path, None, pfield, format!("mode {:?} is not supported (only triangles)", prim.mode())));
+                }
+                use gltf::Semantic;
+                // Output bytes per value: positions and normals 12, UVs 8, indices 4 read then 4 as triangles.
+                for (a, size) in [(prim.get(&Semantic::Positions), 12), (prim.get(&Semantic::Normals), 12), (prim.get(&Semantic::TexCoords(0)), 8), (prim.indices(), 8)] {
+                    if let Some(a) = a {
+                        check_accessor(&a, size).map_err(|e| LoadError::new(path, None, pfield.clone(), e))?;
+                    }
                 }
                 let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
                 let positions: Vec<Vec3> = reader.read_positions().ok_or_else(|| LoadError::new(path, None, pfield.clone(), "has no POSITION"))?.map(|p| to_world.point(Vec3::from_array(p))).collect();
@@ -131,6 +139,25 @@ pub fn parse_gltf(path: &Path) -> Result<SceneDescription, LoadError> {
         desc.geometry.add_mesh(mesh);
     }
     Ok(desc)
+}
+
+/// An accessor's count is the file's word: one that runs past its buffer view (the `gltf`
+/// crate would read it as absent), is 0 (its reader would underflow), or whose values would
+/// need more memory than this process may use (a sparse accessor without a view is `count`
+/// zeros) is refused before the reader allocates.
+fn check_accessor(a: &gltf::Accessor, out_size: u64) -> Result<(), String> {
+    let (i, count) = (a.index(), a.count());
+    if count == 0 {
+        return Err(format!("accessors[{i}] has a count of 0"));
+    }
+    if let (Some(view), None) = (a.view(), a.sparse()) {
+        let stride = view.stride().unwrap_or(a.size());
+        let end = stride.checked_mul(count - 1).and_then(|b| b.checked_add(a.offset() + a.size()));
+        if end.is_none_or(|end| end > view.length()) {
+            return Err(format!("accessors[{i}]: {count} values run past bufferViews[{}] ({} bytes)", view.index(), view.length()));
+        }
+    }
+    raylab_render::memory_guard::check(&format!("accessors[{i}] ({count} values)"), (count as u64).checked_mul(out_size))
 }
 
 /// The bytes of a `data:` URI (after `data:`): `[<media type>];base64,<payload>`, as glTF

@@ -13,6 +13,7 @@ pub mod gltf;
 pub mod image_io;
 pub mod mesh_scene;
 pub mod obj;
+mod obj_read;
 pub mod octahedral;
 pub mod patches;
 pub mod pbrt;

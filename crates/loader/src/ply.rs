@@ -215,16 +215,24 @@ pub fn read_ply(path: &Path, bytes: &[u8], to_world: &Transform) -> Result<Trian
     // A binary file cannot hold more elements than bytes: refuse absurd counts before allocating.
     let body_len = bytes.len() - body_start;
     for e in &elements {
-        let min_size: usize = if format == Format::Ascii { 2 } else { e.properties.iter().map(|(_, t)| match t { PropertyType::Scalar(s) => s.size(), PropertyType::List(c, _) => c.size() }).sum::<usize>().max(1) };
+        // ASCII: at least a digit and a separator per property.
+        let min_size: usize = if format == Format::Ascii { 2 * e.properties.len().max(1) } else { e.properties.iter().map(|(_, t)| match t { PropertyType::Scalar(s) => s.size(), PropertyType::List(c, _) => c.size() }).sum::<usize>().max(1) };
         if e.count.saturating_mul(min_size) > body_len {
             return Err(LoadError::file(path, format!("element `{}` claims {} entries, more than the file's {body_len} bytes can hold", e.name, e.count)));
         }
     }
+    // Counts the file can hold may still need more memory than the machine has: refused
+    // before reserving (a vertex keeps at most a position, a normal and a UV: 32 bytes; a
+    // face at least one triangle: 12).
+    let count = |name: &str| elements.iter().find(|e| e.name == name).map_or(0, |e| e.count);
+    let (nv, nf) = (count("vertex"), count("face"));
+    let need = (nv as u64).checked_mul(32).and_then(|v| v.checked_add((nf as u64).checked_mul(12)?));
+    raylab_render::memory_guard::check(&format!("its {nv} vertices and {nf} faces"), need).map_err(|e| LoadError::file(path, e))?;
     let mut body = Body { path, format, bytes, pos: body_start, tokens: Vec::new(), next_token: 0, line: header_lines };
-    let mut positions = Vec::new();
+    let mut positions = Vec::with_capacity(nv);
     let mut normals = Vec::new();
     let mut uvs = Vec::new();
-    let mut indices: Vec<[u32; 3]> = Vec::new();
+    let mut indices: Vec<[u32; 3]> = Vec::with_capacity(nf);
     let mut has_faces = false;
     for e in &elements {
         let find = |names: &[&str]| names.iter().find_map(|n| e.properties.iter().position(|(p, t)| p == n && matches!(t, PropertyType::Scalar(_))));
