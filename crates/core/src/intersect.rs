@@ -273,6 +273,23 @@ mod tests {
         assert!(triangle(&r, a, b, c).is_none());
     }
 
+    /// pbrt-v4's bound (§6.8.4) written out for max |x'| = 1, |y'| = 2, |z'| = 3, max |e| = 4,
+    /// 1/|det| = 0.5: δz = 3γ₃, δx = γ₅(1 + 3), δy = γ₅(2 + 3), δe = 2(γ₂·1·2 + δy·1 + δx·2),
+    /// δt = 3(γ₃·4·3 + δe·3 + δz·4)·0.5 = 36γ₃ + 18γ₂ + 117γ₅.
+    #[test]
+    fn t_error_bound_is_pbrts_formula() {
+        let g = |n: f64| n * 2f64.powi(-53) / (1.0 - n * 2f64.powi(-53));
+        for n in [1u32, 2, 3, 5, 7] {
+            assert_eq!(gamma_f64(n), g(n as f64), "γ{n}");
+        }
+        let expected = 36.0 * g(3.0) + 18.0 * g(2.0) + 117.0 * g(5.0);
+        let bound = t_error_bound(1.0, 2.0, 3.0, 4.0, 0.5, gamma_f64);
+        assert!((bound - expected).abs() <= 1e-12 * expected, "{bound} vs {expected}");
+        let bound32 = t_error_bound(1.0f32, 2.0, 3.0, 4.0, 0.5, gamma);
+        let expected32 = 36.0 * gamma(3) + 18.0 * gamma(2) + 117.0 * gamma(5);
+        assert!((bound32 - expected32).abs() <= 1e-5 * expected32, "{bound32} vs {expected32}");
+    }
+
     #[test]
     fn sphere_hand_computed() {
         let r = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z);

@@ -46,6 +46,10 @@ fn barycentrics_and_distance_by_hand() {
         let (t, b1, b2) = triangle(&Ray::new(Vec3::ZERO, r(v(0.2, 0.3, 1.0))), r(p0), r(p1), r(p2)).unwrap();
         assert!((t - 1.0).abs() < 1e-6 && (b1 - 0.2).abs() < 1e-6 && (b2 - 0.3).abs() < 1e-6, "{t} {b1} {b2}");
     }
+    // Twice as large a triangle (det 4, not 1, where v·(1/det) = v/(1/det)): the same weights.
+    let (q1, q2) = (v(2.0, 0.0, 1.0), v(0.0, 2.0, 1.0));
+    let (t, b1, b2) = triangle(&Ray::new(Vec3::ZERO, v(0.4, 0.6, 1.0)), p0, q1, q2).unwrap();
+    assert!((t - 1.0).abs() < 1e-6 && (b1 - 0.2).abs() < 1e-6 && (b2 - 0.3).abs() < 1e-6, "{t} {b1} {b2}");
     // The corners' weights: p0 (0, 0), p1 (1, 0), p2 (0, 1).
     for (p, w) in [(p0, (0.0, 0.0)), (p1, (1.0, 0.0)), (p2, (0.0, 1.0))] {
         let (_, b1, b2) = triangle(&Ray::new(p + Vec3::Z, -Vec3::Z), p0, p1, p2).unwrap();
@@ -130,5 +134,25 @@ fn an_edge_function_rounded_to_zero_takes_its_sign_from_double_precision() {
     let inside = Ray::new(v(-(2f32.powi(-20)), 2f32.powi(-20), 0.0), Vec3::Z);
     for (a, b, c) in [(p0, p1, p2), (p1, p2, p0), (p2, p0, p1)] {
         assert_eq!(triangle(&inside, a, b, c).map(|h| h.0), Some(1.0), "{a} {b} {c}");
+    }
+}
+
+/// A point outside a triangle is outside one edge (one edge function of the wrong sign) or
+/// beyond a corner (two of them); with the winding reversed every sign flips. Each of the
+/// twelve cases, with each of the three edge functions as the odd one out, is a miss.
+#[test]
+fn every_outside_region_in_both_windings_is_a_miss() {
+    let (p0, p1, p2) = (v(-1.0, -1.0, 0.0), v(1.0, -1.0, 0.0), v(0.0, 1.0, 0.0));
+    // Across the edges p0p1, p1p2, p2p0, and beyond the corners p0, p1, p2.
+    let outside = [v(0.0, -1.5, 1.0), v(0.8, 0.5, 1.0), v(-0.8, 0.5, 1.0), v(-1.5, -1.2, 1.0), v(1.5, -1.2, 1.0), v(0.0, 1.5, 1.0)];
+    for o in outside {
+        let ray = Ray::new(o, -Vec3::Z);
+        assert_eq!(triangle(&ray, p0, p1, p2), None, "{o}");
+        assert_eq!(triangle(&ray, p0, p2, p1), None, "{o}, reversed");
+    }
+    // Inside, in both windings and from both sides: hits.
+    for (o, d) in [(v(0.0, -0.2, 1.0), -Vec3::Z), (v(0.0, -0.2, -1.0), Vec3::Z)] {
+        assert_eq!(triangle(&Ray::new(o, d), p0, p1, p2).map(|h| h.0), Some(1.0));
+        assert_eq!(triangle(&Ray::new(o, d), p0, p2, p1).map(|h| h.0), Some(1.0));
     }
 }
