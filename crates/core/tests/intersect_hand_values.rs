@@ -113,6 +113,8 @@ fn sphere_roots_by_hand() {
     assert!((t - 7.6).abs() < 1e-5, "{t}");
     // A direction of length 4: t in units of it.
     assert_eq!(at(o, 4.0 * Vec3::Z, 0.0, f32::INFINITY), Some(1.0));
+    // ... and its far root, 2, when the interval cuts the near one.
+    assert_eq!(at(o, 4.0 * Vec3::Z, 1.0, f32::INFINITY), Some(2.0));
 }
 
 /// Where single precision rounds an edge function to exactly 0, its sign comes from double
@@ -154,5 +156,24 @@ fn every_outside_region_in_both_windings_is_a_miss() {
     for (o, d) in [(v(0.0, -0.2, 1.0), -Vec3::Z), (v(0.0, -0.2, -1.0), Vec3::Z)] {
         assert_eq!(triangle(&Ray::new(o, d), p0, p1, p2).map(|h| h.0), Some(1.0));
         assert_eq!(triangle(&Ray::new(o, d), p0, p2, p1).map(|h| h.0), Some(1.0));
+    }
+}
+
+/// From just outside a sphere, the near root is the difference of two nearly equal numbers
+/// in the textbook form (`-b - √disc`: about 0.8 minus 0.8 here), which keeps only a few
+/// bits of it; the kernel's form (`c / q`, q of the sign of `-b`) divides instead. Origin
+/// 2⁻¹⁰ outside the unit sphere on the -z axis, so that `c = |o|² − 1 = 2⁻⁹ + 2⁻²⁰` is
+/// exact, and slanted directions, so that `b` is not. Reference: the root in f64.
+#[test]
+fn the_near_root_from_just_outside_keeps_its_precision() {
+    let origin = v(0.0, 0.0, -(1.0 + 2f32.powi(-10)));
+    for degrees in [10.0f32, 25.0, 37.0, 50.0, 60.0] {
+        let (sin, cos) = degrees.to_radians().sin_cos();
+        let d = v(0.0, sin, cos);
+        let t = sphere(&Ray::new(origin, d), Vec3::ZERO, 1.0).unwrap();
+        let (o64, d64) = (origin.as_dvec3(), d.as_dvec3());
+        let (a, half_b, c) = (d64.length_squared(), o64.dot(d64), o64.length_squared() - 1.0);
+        let exact = c / (-half_b + (half_b * half_b - a * c).sqrt());
+        assert!((t as f64 - exact).abs() <= 1e-6 * exact, "{degrees}°: t {t} against {exact}");
     }
 }
