@@ -132,6 +132,12 @@ fn an_edge_function_rounded_to_zero_takes_its_sign_from_double_precision() {
     for (a, b, c) in [(p0, p1, p2), (p1, p2, p0), (p2, p0, p1)] {
         assert_eq!(triangle(&ray, a, b, c), None, "{a} {b} {c}");
     }
+    // The mirror case: inside by 2⁻²⁵, `(1 + 2⁻¹²)² − (1 + 2⁻¹¹) = +2⁻²⁴` exactly, 0 in f32:
+    // a hit in every rotation.
+    let (q0, q1, q2) = (v(-1.0, 1.0, 1.0), v(1.0 + e12, 1.0, 1.0), v(-(1.0 + e11), -(1.0 + e12), 1.0));
+    for (a, b, c) in [(q0, q1, q2), (q1, q2, q0), (q2, q0, q1)] {
+        assert_eq!(triangle(&ray, a, b, c).map(|h| h.0), Some(1.0), "{a} {b} {c}");
+    }
     // Moved inside the edge by 2⁻²⁰ (far more than the rounding), the ray hits, in every rotation.
     let inside = Ray::new(v(-(2f32.powi(-20)), 2f32.powi(-20), 0.0), Vec3::Z);
     for (a, b, c) in [(p0, p1, p2), (p1, p2, p0), (p2, p0, p1)] {
@@ -151,6 +157,13 @@ fn every_outside_region_in_both_windings_is_a_miss() {
         let ray = Ray::new(o, -Vec3::Z);
         assert_eq!(triangle(&ray, p0, p1, p2), None, "{o}");
         assert_eq!(triangle(&ray, p0, p2, p1), None, "{o}, reversed");
+    }
+    // Exactly on each edge and corner (an edge function exactly 0, the others of one sign),
+    // in both windings: hits.
+    for o in [v(0.0, -1.0, 1.0), v(0.5, 0.0, 1.0), v(-0.5, 0.0, 1.0), v(-1.0, -1.0, 1.0), v(1.0, -1.0, 1.0), v(0.0, 1.0, 1.0)] {
+        let ray = Ray::new(o, -Vec3::Z);
+        assert_eq!(triangle(&ray, p0, p1, p2).map(|h| h.0), Some(1.0), "{o}");
+        assert_eq!(triangle(&ray, p0, p2, p1).map(|h| h.0), Some(1.0), "{o}, reversed");
     }
     // Inside, in both windings and from both sides: hits.
     for (o, d) in [(v(0.0, -0.2, 1.0), -Vec3::Z), (v(0.0, -0.2, -1.0), Vec3::Z)] {
