@@ -1,7 +1,8 @@
 //! The generators' geometry, not only their counts: positions, sizes and contacts follow
 //! from each construction, and the expected values are worked out here.
 
-use raylab_core::Vec3;
+use raylab_core::{Rgb, Vec2, Vec3};
+use raylab_render::Light;
 use raylab_procedural::{generate, Size};
 
 fn size(size: u32) -> Size {
@@ -141,4 +142,53 @@ fn hair_strands_start_inside_the_ball_and_advance_in_equal_steps() {
         let (root, tip) = (ends[0].w, ends.last().unwrap().w);
         assert!((tip - 0.33 * root).abs() < 1e-6 * root.max(1.0), "strand {k}: {root} → {tip}");
     }
+}
+
+#[test]
+fn sphereflake_levels_alternate_materials_and_the_cap_is_turned_half_a_radian() {
+    let g = generate("balls", size(2)).unwrap();
+    let name = |s: &raylab_render::shape::Sphere| g.scene.material_names[s.material.0 as usize].clone();
+    let s = &g.scene.geometry.spheres;
+    // Depth 2 at the root: mirror, then `a` for the 9 children, mirror for the 81 grandchildren.
+    assert_eq!(name(&s[0]), "mirror");
+    let by_radius = |r: f32| s.iter().filter(|x| (x.radius - r).abs() < 1e-6).map(name).collect::<Vec<_>>();
+    assert!(by_radius(1.0 / 3.0).iter().all(|n| n == "a") && by_radius(1.0 / 3.0).len() == 9);
+    assert!(by_radius(1.0 / 9.0).iter().all(|n| n == "mirror") && by_radius(1.0 / 9.0).len() == 81);
+    let g1 = generate("balls", size(1)).unwrap();
+    assert_eq!(g1.scene.material_names[g1.scene.geometry.spheres[0].material.0 as usize], "a");
+
+    // The root's children (the first of each subtree in generation order): six on the
+    // equator at 60° steps, three on the cap at 120° steps starting 0.5 rad past the first
+    // equator child, azimuths measured around +y in the equator's own direction of turning.
+    let kids: Vec<Vec3> = generate("balls", size(1)).unwrap().scene.geometry.spheres[1..].iter().map(|x| x.center).collect();
+    let flat = |p: Vec3| Vec3::new(p.x, 0.0, p.z).normalize();
+    let e0 = flat(kids[0]);
+    let e90 = (flat(kids[1]) - 0.5 * e0).normalize();
+    let azimuth = |p: Vec3| flat(p).dot(e90).atan2(flat(p).dot(e0)).rem_euclid(std::f32::consts::TAU);
+    for (j, k) in kids[6..].iter().enumerate() {
+        let expected = 0.5 + j as f32 * std::f32::consts::TAU / 3.0;
+        assert!((azimuth(*k) - expected).abs() < 1e-4, "cap child {j}: azimuth {} against {expected}", azimuth(*k));
+    }
+    // The viewpoint is SPD balls' direction (2.1, 1.3, 1.7), 1.6 times as far.
+    assert_eq!(g.scene.camera.from, Vec3::new(2.1, 1.3, 1.7) * 1.6);
+}
+
+#[test]
+fn the_floor_is_a_quad_of_the_second_material_with_its_corners_uvs() {
+    let g = generate("balls", size(1)).unwrap();
+    let floor = g.scene.geometry.meshes.last().unwrap();
+    assert_eq!(floor.positions, [Vec3::new(-20.0, -1.0, -20.0), Vec3::new(20.0, -1.0, -20.0), Vec3::new(20.0, -1.0, 20.0), Vec3::new(-20.0, -1.0, 20.0)]);
+    assert_eq!(floor.uvs, [Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0)]);
+    assert_eq!(floor.indices, [[0, 1, 2], [0, 2, 3]]);
+    assert_eq!(g.scene.material_names[floor.material.0 as usize], "b");
+    // Lit as every SPD scene here: a point light up, left and in front, and an ambient term.
+    assert_eq!(g.scene.lights, [Light::Point { position: Vec3::new(-40.0, 60.0, 50.0), intensity: Rgb::splat(6000.0) }, Light::Ambient { intensity: Rgb::ONE }]);
+}
+
+#[test]
+fn sizes_up_to_each_limit_are_accepted_and_beyond_refused() {
+    assert_eq!(generate("rings", size(64)).unwrap().scene.geometry.spheres.len(), 12 * (64 * 65 / 2));
+    assert_eq!(generate("rings", size(65)).err().unwrap(), "--size for `rings` must be between 1 and 64, found 65");
+    assert_eq!(generate("balls", size(0)).err().unwrap(), "--size for `balls` must be between 1 and 6, found 0");
+    assert_eq!(generate("cubes", size(1)).err().unwrap(), "unknown generator `cubes` (valid: balls, rings, tetra, mount, hair)");
 }
