@@ -192,3 +192,80 @@ fn sizes_up_to_each_limit_are_accepted_and_beyond_refused() {
     assert_eq!(generate("balls", size(0)).err().unwrap(), "--size for `balls` must be between 1 and 6, found 0");
     assert_eq!(generate("cubes", size(1)).err().unwrap(), "unknown generator `cubes` (valid: balls, rings, tetra, mount, hair)");
 }
+
+#[test]
+fn rings_turn_in_equal_steps_and_alternate_materials() {
+    let g = generate("rings", size(2)).unwrap();
+    let s = &g.scene.geometry.spheres;
+    for (ring, range) in [(1usize, 0..12), (2, 12..36)] {
+        let count = 12 * ring;
+        let step = std::f32::consts::TAU / count as f32;
+        for k in range.clone() {
+            let c = s[k].center;
+            let angle = c.z.atan2(c.x).rem_euclid(std::f32::consts::TAU);
+            let expected = (k - range.start) as f32 * step;
+            assert!((angle - expected).abs() < 1e-4, "ring {ring}, sphere {k}: angle {angle} against {expected}");
+            let material = &g.scene.material_names[s[k].material.0 as usize];
+            assert_eq!(material, if ring % 2 == 0 { "a" } else { "mirror" });
+        }
+    }
+    // The camera looks down from above and in front, at 1.2 and 1.8 times the extent (2 per
+    // ring); the floor reaches 3 extents out.
+    assert_eq!((g.scene.camera.from, g.scene.camera.at), (Vec3::new(0.0, 4.8, 7.2), Vec3::ZERO));
+    let floor = g.scene.geometry.meshes.last().unwrap();
+    assert_eq!((floor.positions[0], floor.positions[2]), (Vec3::new(-12.0, 0.0, -12.0), Vec3::new(12.0, 0.0, 12.0)));
+}
+
+#[test]
+fn sierpinski_children_are_the_corners_and_edge_midpoints() {
+    let g = generate("tetra", size(1)).unwrap();
+    let m = &g.scene.geometry.meshes[0];
+    assert_eq!((m.name.as_str(), g.scene.material_names[m.material.0 as usize].as_str()), ("sierpinski", "a"));
+    let corners = [Vec3::new(1.0, 1.0, 1.0), Vec3::new(-1.0, -1.0, 1.0), Vec3::new(-1.0, 1.0, -1.0), Vec3::new(1.0, -1.0, -1.0)];
+    let mut expected: Vec<[i32; 3]> = corners.iter().map(|c| c.as_ivec3().to_array()).collect();
+    for i in 0..4 {
+        for j in i + 1..4 {
+            expected.push(((corners[i] + corners[j]) * 0.5).as_ivec3().to_array());
+        }
+    }
+    let mut got: Vec<[i32; 3]> = m.positions.iter().map(|p| p.as_ivec3().to_array()).collect();
+    assert!(m.positions.iter().all(|p| *p == p.round()), "vertices off the integer lattice");
+    expected.sort();
+    got.sort();
+    got.dedup();
+    assert_eq!(got, expected);
+    assert_eq!(g.scene.camera.from, Vec3::new(1.6, 2.2, 3.6));
+    let floor = g.scene.geometry.meshes.last().unwrap();
+    assert_eq!((floor.positions[0], floor.positions[2]), (Vec3::new(-20.0, -1.0, -20.0), Vec3::new(20.0, -1.0, 20.0)));
+}
+
+/// Diamond-square: the grid's corners are never displaced; every height is an average of
+/// earlier heights plus at most the level's amplitude (0.5, then ×0.55 per level), so no
+/// height exceeds 0.5 / (1 − 0.55); heights below −0.3 are clamped there.
+#[test]
+fn the_mountain_is_midpoint_displacement_within_its_amplitudes() {
+    let g = generate("mount", size(6)).unwrap();
+    let m = &g.scene.geometry.meshes[0];
+    let n = 64usize;
+    let y = |x: usize, z: usize| m.positions[z * (n + 1) + x].y;
+    assert_eq!([y(0, 0), y(n, 0), y(0, n), y(n, n)], [0.0; 4]);
+    let (lo, hi) = m.positions.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), p| (lo.min(p.y), hi.max(p.y)));
+    assert!(hi <= 0.5 / 0.45 + 1e-5 && hi > 0.3, "highest {hi}");
+    assert_eq!(lo, -0.3, "lowest {lo}");
+    // Level 1 alone (a 2 × 2 grid): the centre is displaced from 0 by at most 0.5; each edge
+    // midpoint from the mean of its three neighbours (two corners at 0, the centre) by at most 0.5.
+    let g = generate("mount", size(1)).unwrap();
+    let p = &g.scene.geometry.meshes[0].positions;
+    let centre = p[4].y;
+    assert!(centre.abs() <= 0.5);
+    for k in [1, 3, 5, 7] {
+        if p[k].y > -0.3 && centre > -0.3 {
+            assert!((p[k].y - centre / 3.0).abs() <= 0.5 + 1e-6, "edge {k}: {} against centre {centre}", p[k].y);
+        }
+    }
+    // Finer levels are smoother: neighbouring heights differ less than the first level's
+    // amplitude almost everywhere.
+    let rough = (0..n).flat_map(|z| (0..n).map(move |x| (x, z))).filter(|&(x, z)| (y(x + 1, z) - y(x, z)).abs() > 0.25).count();
+    assert!(rough < n * n / 100, "{rough} steep steps");
+    assert_eq!(g.scene.camera.from, Vec3::new(0.0, 2.2, 4.0));
+}
