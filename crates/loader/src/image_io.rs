@@ -52,14 +52,25 @@ fn read_8bit(path: &Path, bytes: &[u8], srgb: bool) -> Result<(u32, u32, Vec<Rgb
     Ok((rgb.width(), rgb.height(), pixels))
 }
 
+/// How many bytes of decoded RGB one byte of OpenEXR can give at most: deflate's ratio
+/// (1032:1) times the growth of a 2-byte sample into 12 bytes, rounded up.
+const MAX_EXR_EXPANSION: u64 = 1 << 13;
+
 fn read_exr(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Vec<Rgb>), ImageError> {
     use exr::prelude::*;
     // The pixel buffer is sized from the header before any pixel is read, and compression
     // lets a small file announce a huge image: check the announced sizes first.
+    let bytes_len = bytes.len();
     let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false).map_err(|e| err(path, format!("cannot decode OpenEXR: {e}")))?;
     for h in meta.headers.iter() {
         let (w, ht) = (h.layer_size.width(), h.layer_size.height());
         let bytes = (w as u64).checked_mul(ht as u64).and_then(|n| n.checked_mul(std::mem::size_of::<Rgb>() as u64));
+        // The compressions the exr crate reads pack at most about 1000:1 (deflate's limit;
+        // it reads no DWA), and 2-byte half or single-channel samples grow to 12-byte RGB:
+        // a layer beyond this cannot be in the file.
+        if bytes.is_none_or(|b| b > (bytes_len as u64).saturating_mul(MAX_EXR_EXPANSION)) {
+            return Err(err(path, format!("its {w}×{ht} layer cannot be stored in a file of {bytes_len} bytes")));
+        }
         raylab_render::memory_guard::check(&format!("its {w}×{ht} layer"), bytes).map_err(|e| err(path, e))?;
     }
     let image = read()

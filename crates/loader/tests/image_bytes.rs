@@ -136,3 +136,17 @@ fn exr_writer_stores_linear_float_rgb() {
     // Exposure −1 halves; no tone map on float output; NaN is written as 0.
     assert_eq!((channel(2), channel(1), channel(0)), (vec![0.25, 0.0], vec![1.0, 0.0], vec![50.0, 5e-4]));
 }
+
+/// Found by the `image_exr` fuzz target: a 2 KB file whose header announces a layer of 23 GB
+/// of pixels passed the memory guard on a 24 GB machine and was allocated before decoding
+/// failed. No compression packs that much into that little.
+#[test]
+fn an_exr_announcing_more_pixels_than_its_bytes_can_hold_is_refused() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz");
+    let bytes = std::fs::read(dir.join("regressions/image_exr/huge-layer-in-tiny-file")).unwrap();
+    let e = decode_image(Path::new("x.exr"), &bytes, false).unwrap_err().to_string();
+    assert!(e.starts_with("x.exr: its ") && e.ends_with(&format!(" layer cannot be stored in a file of {} bytes", bytes.len())), "{e}");
+    // A real (small) EXR still reads.
+    let seed = std::fs::read(dir.join("corpus/image_exr/tiny.exr")).unwrap();
+    assert_eq!(decode_image(Path::new("x.exr"), &seed, false).unwrap().0, 4);
+}

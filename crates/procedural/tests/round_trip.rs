@@ -11,15 +11,17 @@ use raylab_loader::Overrides;
 use raylab_procedural::{generate, Size, NAMES};
 use raylab_render::settings::SETTINGS;
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("raylab_gen_round_trip_{}_{name}", std::process::id()));
+/// A folder of this process for one test's scene `name`: tests run in parallel and must not
+/// share (or delete) each other's files.
+fn scratch(test: &str, name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("raylab_gen_round_trip_{}_{test}_{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
 
 /// Writes `desc` into a fresh folder and reads it back through the TOML front end.
-fn round_trip(name: &str, desc: &SceneDescription) -> SceneDescription {
-    let dir = scratch(name);
+fn round_trip(test: &str, name: &str, desc: &SceneDescription) -> SceneDescription {
+    let dir = scratch(test, name);
     let written = write_toml(desc, name, &format!("{name}, round trip")).unwrap_or_else(|e| panic!("{name}: {e}"));
     for f in &written.side_files {
         std::fs::write(dir.join(&f.name), &f.contents).unwrap();
@@ -72,7 +74,7 @@ fn size_of(name: &str) -> Size {
 fn every_generator_reads_back_as_the_description_it_wrote() {
     for &name in NAMES {
         let g = generate(name, size_of(name)).unwrap();
-        let (a, b) = (&g.scene, &round_trip(name, &g.scene));
+        let (a, b) = (&g.scene, &round_trip("every", name, &g.scene));
         let (ca, cb) = (&a.camera, &b.camera);
         assert_eq!((ca.from, ca.at, ca.up, ca.vfov, ca.aperture, ca.focus_distance), (cb.from, cb.at, cb.up, cb.vfov, cb.aperture, cb.focus_distance), "{name}");
         for s in SETTINGS {
@@ -95,7 +97,7 @@ fn a_written_scene_renders_the_image_of_its_description() {
     let o = Overrides { width: Some(48), height: Some(36), spp: Some(1), ..Default::default() };
     for name in ["tetra", "hair"] {
         let g = generate(name, size_of(name)).unwrap();
-        let back = round_trip(name, &g.scene);
+        let back = round_trip("render", name, &g.scene);
         let render = |d: SceneDescription| raylab_render::render(&raylab_loader::build_scene(d, &o).unwrap(), &|_| {}).pixels;
         let (want, got) = (render(g.scene), render(back));
         let worst = want.iter().zip(&got).map(|(p, q)| (*p - *q).abs().max_element()).fold(0.0f32, f32::max);
