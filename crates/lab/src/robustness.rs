@@ -120,10 +120,14 @@ pub fn measure_cell(kind: AccelKind, prims: PrimKind, scale: f32, rays: u64) -> 
         let spawned = Ray::new(origin, dir);
         spawn_rays += 1;
         let again = accel.intersect(&shape.geometry, &spawned, &mut c);
+        // The side is the direction's own: a sample on the hemisphere's rim can round to the
+        // other side of the tangent plane (cos θ = -6e-8), and then the ray is spawned, and
+        // travels, inwards on a grazing chord.
+        let leaving = dir.dot(outward) > 0.0;
         let bad = match again {
             None => false,
             // Leaving a convex shape outwards, nothing is there to hit.
-            Some(_) if k % 2 == 0 => true,
+            Some(_) if leaving => true,
             // Inwards, the far side (or, next to an edge, the neighbouring face at a grazing
             // angle) is a genuine hit; the origin primitive found again close by is not.
             Some(h) => h.prim == hit.prim && (h.t * dir).length() < 1e-3 * scale,
