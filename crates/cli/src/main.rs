@@ -38,7 +38,7 @@ enum Command {
     Bake(commands::bake::BakeArgs),
     /// Join the films of tiles and sample ranges (render --tile/--crop/--samples) into one image
     Merge(commands::merge::MergeArgs),
-    /// Measure leaks and self-intersections of every structure and primitive kind at scales 1e-4..1e5
+    /// Measure leaks and self-intersections of every structure and primitive kind at scales 1e-10..1e12
     Robustness(commands::robustness::RobustnessArgs),
 }
 

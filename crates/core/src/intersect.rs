@@ -107,7 +107,13 @@ impl ShearedRay {
         let max_yt = ay.abs().max(by.abs()).max(cy.abs());
         let max_e = u.abs().max(v.abs()).max(w.abs());
         let delta_t = t_error_bound(max_xt, max_yt, max_zt, max_e, inv_det.abs(), gamma);
-        let t = if t > delta_t {
+        // `t_scaled` is an edge function (a squared distance) times a depth: the cube of the
+        // vertices' distance from the origin, which overflows single precision from ~7e12
+        // (a ray over a ±8e12 floor in a scene scaled by 1e12 missed it). Double precision
+        // has the range.
+        let t = if !(t.is_finite() && delta_t.is_finite()) {
+            self.triangle_t_f64(p0, p1, p2)?
+        } else if t > delta_t {
             t
         } else if t < -delta_t {
             return None;

@@ -5,6 +5,7 @@
 pub mod bounds;
 pub mod color;
 pub mod distribution;
+pub mod edges;
 pub mod frame;
 pub mod intersect;
 #[macro_use]

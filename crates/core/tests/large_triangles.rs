@@ -39,10 +39,12 @@ fn misses(s: f32, unit: f32) -> (usize, usize) {
 }
 
 #[test]
-fn quads_from_1e_minus_4_to_1e7_are_hit_by_every_oblique_ray() {
-    for s in [1e-4f32, 1e-2, 1.0, 1e2, 1e4, 1e6, 3e6, 1e7] {
-        // Heights relative to the quad's own size, and to the unit size.
-        for unit in [s, 1.0] {
+fn quads_from_1e_minus_4_to_1e13_are_hit_by_every_oblique_ray() {
+    for s in [1e-4f32, 1e-2, 1.0, 1e2, 1e4, 1e6, 3e6, 1e7, 1e10, 1e12, 1e13] {
+        // Heights relative to the quad's own size, and to the unit size while that is
+        // above 1e-12 of the quad (double precision's own bound on t is ~1e-15 of it).
+        // From 1e12 the kernel's single-precision `t` overflowed: rays missed.
+        for unit in if s <= 1e7 { vec![s, 1.0] } else { vec![s] } {
             let (missed, n) = misses(s, unit);
             assert_eq!(missed, 0, "quad ±{s}, heights around {unit}: {missed} of {n} rays missed");
         }

@@ -1,5 +1,5 @@
 //! Geometric robustness, measured (issue 12): for every structure and primitive kind, at
-//! scene scales from 1e-4 to 1e5,
+//! scene scales from 1e-10 to 1e12,
 //! - **leaks**: rays from inside a closed shape (an icosphere aimed exactly at its vertices
 //!   and at points of its edges; a sphere; a capsule-shaped curve) that escape it;
 //! - **self-intersections**: secondary rays spawned from a hit as the renderer spawns them
@@ -18,8 +18,9 @@ use raylab_render::MaterialId;
 use rayon::prelude::*;
 use serde::Serialize;
 
-/// Scene scales of the table: the shapes have this size (radius, half-length).
-pub const SCALES: [f32; 10] = [1e-4, 1e-3, 1e-2, 1e-1, 1.0, 1e1, 1e2, 1e3, 1e4, 1e5];
+/// Scene scales of the table: the shapes have this size (radius, half-length). Every
+/// decade near the unit, every second one out to the issue's 1e-10 and 1e12.
+pub const SCALES: [f32; 17] = [1e-10, 1e-8, 1e-6, 1e-4, 1e-3, 1e-2, 1e-1, 1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e8, 1e10, 1e12];
 
 /// The primitive kinds of the table.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -119,10 +120,14 @@ pub fn measure_cell(kind: AccelKind, prims: PrimKind, scale: f32, rays: u64) -> 
         let spawned = Ray::new(origin, dir);
         spawn_rays += 1;
         let again = accel.intersect(&shape.geometry, &spawned, &mut c);
+        // The side is the direction's own: a sample on the hemisphere's rim can round to the
+        // other side of the tangent plane (cos θ = -6e-8), and then the ray is spawned, and
+        // travels, inwards on a grazing chord.
+        let leaving = dir.dot(outward) > 0.0;
         let bad = match again {
             None => false,
             // Leaving a convex shape outwards, nothing is there to hit.
-            Some(_) if k % 2 == 0 => true,
+            Some(_) if leaving => true,
             // Inwards, the far side (or, next to an edge, the neighbouring face at a grazing
             // angle) is a genuine hit; the origin primitive found again close by is not.
             Some(h) => h.prim == hit.prim && (h.t * dir).length() < 1e-3 * scale,
@@ -208,7 +213,9 @@ impl Shape {
                 let [a, b] = self.edges[rng.below(self.edges.len() as u32) as usize];
                 a + (b - a) * rng.next_f32()
             }
-            _ => origin + uniform_sphere(rng.next_vec2()),
+            // A direction, not a target a unit away: at scale 1e8 a unit is below the
+            // origin's ulp and `target - origin` rounds to zero.
+            _ => return Ray::new(origin, uniform_sphere(rng.next_vec2())),
         };
         Ray::new(origin, (target - origin).normalize())
     }
@@ -281,19 +288,17 @@ mod tests {
     }
 
     /// The table's target, on a few cells of every kind: no leaks, no self-intersections.
-    /// Curves are the known exception (docs/robustness.md): rays leaving a strand inwards
-    /// near a segment's end find that segment again (at u = 0 or 1, within 1e-3 of the
-    /// strand's size), about 1 % of them at every scale; their leaks are still 0.
+    /// (Curves re-hit the interior halves of their joint and end spheres from inside, about
+    /// 1 % of inward rays, until the intersector kept only the union's boundary; triangles
+    /// at 1e12 had single-precision normals that overflowed to +y, 29 % of spawned rays.)
     #[test]
     fn no_leaks_and_no_self_intersections() {
-        let r = measure(&[AccelKind::None, AccelKind::Bvh, AccelKind::Grid, AccelKind::Bvh8], &[1e-4, 1.0, 1e5], 400);
+        let r = measure(&[AccelKind::None, AccelKind::Bvh, AccelKind::Grid, AccelKind::Bvh8], &[1e-10, 1e-4, 1.0, 1e5, 1e12], 400);
         for c in &r.cells {
             assert!(c.spawn_rays > 300, "{c:?}: too few primary rays hit the shape");
             assert_eq!(c.leak_rays, if c.prims.has_leak_test() { 400 } else { 0 }, "{c:?}");
             assert_eq!(c.leaks, 0, "{c:?}");
-            if c.prims != PrimKind::Curves {
-                assert_eq!(c.self_intersections, 0, "{c:?}");
-            }
+            assert_eq!(c.self_intersections, 0, "{c:?}");
         }
     }
 }

@@ -642,7 +642,7 @@ impl Builder<'_> {
         if verts.len() != 4 {
             return Err(vv.err(format!("expected 4 vertices, found {}", verts.len())));
         }
-        if (verts[1] - verts[0]).cross(verts[2] - verts[0]).length_squared() == 0.0 {
+        if raylab_core::edges::unit_cross(verts[1] - verts[0], verts[2] - verts[0]).is_none() {
             return Err(vv.err("the first three vertices must not be collinear"));
         }
         Ok(verts)

@@ -131,8 +131,7 @@ fn rays_leaving_a_curve_do_not_hit_it_again() {
     let mut scene = Scene::new(camera, RenderSettings::default());
     scene.geometry = g;
     scene.build_accel(&BuildOptions::default());
-    // Rays start outside the strands: a tube is a union of frusta and spheres, whose
-    // boundary is only found from outside.
+    // Rays start outside the strands (rays from inside: the capsule test below).
     let rays = rays_at(&mut rng, &scene.geometry, 4000, true);
     let mut c = Counters::default();
     let mut tested = 0;
@@ -189,5 +188,61 @@ fn sixteen_sided_tubes_render_like_direct_curves() {
         let (tube16, tube4) = (mse(&hair_render(Some(16), integrator), &direct), mse(&hair_render(Some(4), integrator), &direct));
         // Measured: 1.0e-6 and 1.6e-6 for 16 sides, 6e-5 for 4 (mean radiance 0.0086).
         assert!(tube16 < 1e-5 && tube16 < 0.1 * tube4, "{integrator}: MSE of tube16 {tube16}, of tube4 {tube4}");
+    }
+}
+
+/// A straight strand of three cubic segments from x = -1.5 to 1.5 times `scale`, radius a
+/// fifth of `scale`: a capsule, whose surface is where the distance to the axis segment
+/// is the radius. Its joints and round ends are where interior pieces can be hit.
+fn capsule(scale: f32) -> (Scene, f32) {
+    let r = 0.2 * scale;
+    let seg = |x0: f32| Bezier::new(&(0..4).map(|k| Vec4::new((x0 + k as f32 / 3.0) * scale, 0.0, 0.0, r)).collect::<Vec<_>>()).unwrap();
+    let camera = Camera::new(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, Vec3::Y, 45.0, 1.0, 0.0, None).unwrap();
+    let mut scene = Scene::new(camera, RenderSettings::default());
+    scene.geometry.add_curve(Curve::new(vec![seg(-1.5), seg(-0.5), seg(0.5)], MaterialId::default()));
+    scene.build_accel(&BuildOptions::default());
+    (scene, r)
+}
+
+/// How far the hit of `ray` at `t` lies outside (+) or inside (-) the capsule's surface,
+/// relative to its radius (in f64, so that only the error of `t` counts).
+fn capsule_depth(ray: &Ray, t: f32, scale: f32, r: f32) -> f64 {
+    let p = ray.origin.as_dvec3() + t as f64 * ray.dir.as_dvec3();
+    let x = p.x.clamp(-1.5 * scale as f64, 1.5 * scale as f64);
+    ((p - glam::DVec3::new(x, 0.0, 0.0)).length() - r as f64) / r as f64
+}
+
+#[test]
+fn rays_from_inside_a_strand_find_its_surface_not_its_joints() {
+    for scale in [1e-4f32, 1.0, 1e4] {
+        let (scene, r) = capsule(scale);
+        let mut rng = Pcg32::new(12, scale.to_bits() as u64);
+        let mut c = Counters::default();
+        // From anywhere inside (near the joints at x = ±0.5 and the ends half the time),
+        // in every direction: the exit, on the surface. Before the tube was a union, the
+        // interior halves of joint and end spheres were hit first.
+        for k in 0..2000 {
+            let x = if k % 2 == 0 { [-1.5f32, -0.5, 0.5, 1.5][k / 2 % 4] + 0.3 * (rng.next_f32() - 0.5) } else { 3.0 * rng.next_f32() - 1.5 };
+            let x = x.clamp(-1.5, 1.5);
+            let origin = Vec3::new(x * scale, 0.0, 0.0) + 0.9 * r * rng.next_f32() * sampling::uniform_sphere(rng.next_vec2());
+            let ray = Ray::new(origin, sampling::uniform_sphere(rng.next_vec2()));
+            let hit = scene.intersect(&ray, &mut c).unwrap_or_else(|| panic!("scale {scale} ray {k}: leaked out of the strand"));
+            let depth = capsule_depth(&ray, hit.t, scale, r);
+            assert!(depth.abs() < 1e-4, "scale {scale} ray {k} from {origin}: hit {depth} r off the surface (prim {})", hit.prim);
+        }
+        // Spawned inwards from hits near the joints and ends, as the renderer spawns them:
+        // the far side, never an interior piece just below the origin.
+        let mut tested = 0;
+        while tested < 2000 {
+            let x = [-1.5, -0.5, 0.5, 1.5][tested % 4] + 0.1 * (rng.next_f32() - 0.5);
+            let from = 3.0 * scale * sampling::uniform_sphere(rng.next_vec2());
+            let Some(hit) = scene.intersect(&Ray::new(from, Vec3::new(x * scale, 0.0, 0.0) - from), &mut c) else { continue };
+            let dir = raylab_core::Frame::from_z(-hit.geom.ng).to_world(sampling::cosine_hemisphere(rng.next_vec2()));
+            let ray = hit.spawn(dir);
+            let again = scene.intersect(&ray, &mut c).unwrap_or_else(|| panic!("scale {scale} spawned ray {tested}: leaked out"));
+            let depth = capsule_depth(&ray, again.t, scale, r);
+            assert!(depth.abs() < 1e-4, "scale {scale} spawned ray {tested}: re-hit {depth} r off the surface at t = {} (prim {})", again.t, again.prim);
+            tested += 1;
+        }
     }
 }

@@ -327,7 +327,7 @@ fn sample_cells(quad: &Parallelogram, k: u32, p: Vec3, receiver: Receiver, le_at
     let cell = Vec2::new((chosen % k) as f32, (chosen / k) as f32);
     let st = (cell + u) / k as f32;
     let q = quad.corner + st.x * quad.e1 + st.y * quad.e2;
-    let area = quad.e1.cross(quad.e2).length();
+    let area = raylab_core::edges::cross_length(quad.e1, quad.e2);
     // The rect's UVs run (0,0), (1,0), (1,1), (0,1) around its corners: `st` itself.
     towards(p, q, quad.normal, le_at(st, q), choice * prob(weights[chosen]) * cells / area)
 }

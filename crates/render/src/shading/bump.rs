@@ -26,7 +26,7 @@ pub fn bumped_normal(height: &Texture, scale: f32, g: &SurfaceGeometry) -> Vec3 
     let dpdv = g.dpdv - n * n.dot(g.dpdv);
     let dpdu = dpdu.try_normalize().map_or(dpdu, |t| t * g.dpdu.length()) + (d(DELTA, 0.0) - d0) / DELTA * n;
     let dpdv = dpdv.try_normalize().map_or(dpdv, |t| t * g.dpdv.length()) + (d(0.0, DELTA) - d0) / DELTA * n;
-    match dpdu.cross(dpdv).try_normalize() {
+    match raylab_core::edges::unit_cross(dpdu, dpdv) {
         Some(nb) if nb.dot(n) < 0.0 => -nb,
         Some(nb) => nb,
         None => n,

@@ -48,12 +48,12 @@ impl TriangleMesh {
     /// emitting triangle lights.
     pub fn winding_normal(&self, tri: u32) -> Vec3 {
         let [a, b, c] = self.vertices(tri);
-        (b - a).cross(c - a).try_normalize().unwrap_or(Vec3::Y)
+        raylab_core::edges::unit_cross(b - a, c - a).unwrap_or(Vec3::Y)
     }
 
     pub fn area(&self, tri: u32) -> f32 {
         let [a, b, c] = self.vertices(tri);
-        0.5 * (b - a).cross(c - a).length()
+        0.5 * raylab_core::edges::cross_length(b - a, c - a)
     }
 
     pub fn triangle_bounds(&self, tri: u32) -> Aabb {
@@ -81,7 +81,7 @@ impl TriangleMesh {
         let p_error = raylab_core::gamma(7) * ((b0 * p0).abs() + (b1 * p1).abs() + (b2 * p2).abs());
         let e1 = p1 - p0;
         let e2 = p2 - p0;
-        let mut ng = e1.cross(e2).try_normalize().unwrap_or(Vec3::Y);
+        let mut ng = raylab_core::edges::unit_cross(e1, e2).unwrap_or(Vec3::Y);
         let (uv, (dpdu, dpdv)) = if self.uvs.is_empty() {
             (Vec2::new(b1, b2), (e1, e2))
         } else {
@@ -123,11 +123,11 @@ impl TriangleMesh {
         let mut around = vec![Vec::new(); group_of.len()];
         for (f, &tri) in self.indices.iter().enumerate() {
             let p = tri.map(|i| self.positions[i as usize]);
-            let face = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize();
+            let face = raylab_core::edges::unit_cross(p[1] - p[0], p[2] - p[0]);
             faces.push(face);
             let Some(face) = face else { continue };
             for k in 0..3 {
-                let angle = (p[(k + 1) % 3] - p[k]).angle_between(p[(k + 2) % 3] - p[k]);
+                let angle = raylab_core::edges::angle_between(p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
                 if angle.is_finite() {
                     around[groups[tri[k] as usize]].push((f, angle * face));
                 }
@@ -179,9 +179,9 @@ impl TriangleMesh {
             let p = tri.map(|i| self.positions[i as usize]);
             let t = tri.map(|i| self.uvs[i as usize]);
             let Some((dpdu, dpdv)) = uv_derivatives(p[1] - p[0], p[2] - p[0], t[1] - t[0], t[2] - t[0]) else { continue };
-            let (Some(tu), Some(tv), Some(face)) = (dpdu.try_normalize(), dpdv.try_normalize(), (p[1] - p[0]).cross(p[2] - p[0]).try_normalize()) else { continue };
+            let (Some(tu), Some(tv), Some(face)) = (dpdu.try_normalize(), dpdv.try_normalize(), raylab_core::edges::unit_cross(p[1] - p[0], p[2] - p[0])) else { continue };
             for k in 0..3 {
-                let angle = (p[(k + 1) % 3] - p[k]).angle_between(p[(k + 2) % 3] - p[k]);
+                let angle = raylab_core::edges::angle_between(p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
                 if angle.is_finite() {
                     let i = tri[k] as usize;
                     su[i] += angle * tu;

@@ -68,8 +68,10 @@ impl Curve {
 
     #[inline]
     pub fn intersect(&self, seg: u32, ray: &Ray) -> Option<CurveHit> {
-        let (cp, depth) = &self.cubics[seg as usize];
-        intersect::intersect(cp, *depth, ray)
+        let seg = seg as usize;
+        let cubic = |k: usize| self.cubics.get(k).map(|(cp, depth)| (cp, *depth));
+        let (cp, depth) = &self.cubics[seg];
+        intersect::intersect(cp, *depth, [seg.checked_sub(1).and_then(cubic), cubic(seg + 1)], ray)
     }
 
     /// Surface data at a hit of segment `seg` at distance `t`, curve parameter `u` and
