@@ -241,30 +241,11 @@ fn assert_cook_torrance(bsdf: raylab_render::bsdf::Bsdf, diffuse: Rgb, f0: Rgb, 
 fn gltf_metallic_roughness_textures_vary_the_brdf_per_point() {
     let dir = std::env::temp_dir().join(format!("raylab_gltf_mr_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let positions: Vec<u8> = [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
-    let uvs: Vec<u8> = [[0f32, 1.0], [1.0, 1.0], [0.0, 0.0]].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
-    let buffer = base64::encode([positions, uvs].concat());
-    // Red (occlusion in packed ORM textures) 255, roughness 102/255 = 0.4, metalness 51/255 = 0.2.
-    let (orm, colour) = (base64::encode(png_1x1([255, 102, 51])), base64::encode(png_1x1([188, 188, 188])));
-    let json = format!(
-        r#"{{
-      "asset": {{"version": "2.0"}},
-      "scenes": [{{"nodes": [0]}}],
-      "nodes": [{{"mesh": 0}}],
-      "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}, "material": 0}}]}}],
-      "materials": [{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}, "baseColorFactor": [1, 0.5, 0.25, 1],
-                      "metallicRoughnessTexture": {{"index": 1}}, "metallicFactor": 1, "roughnessFactor": 0.5}},
-                     "occlusionTexture": {{"index": 1}}, "alphaMode": "MASK"}}],
-      "textures": [{{"source": 0}}, {{"source": 1}}],
-      "images": [{{"uri": "data:image/png;base64,{colour}"}}, {{"uri": "data:image/png;base64,{orm}"}}],
-      "buffers": [{{"uri": "data:application/octet-stream;base64,{buffer}", "byteLength": 60}}],
-      "bufferViews": [{{"buffer": 0, "byteLength": 36}}, {{"buffer": 0, "byteOffset": 36, "byteLength": 24}}],
-      "accessors": [
-        {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}},
-        {{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}}
-      ]
-    }}"#
-    );
+    // Base colour sRGB 188; red (occlusion in packed ORM textures) 255, roughness 102/255 = 0.4, metalness 51/255 = 0.2.
+    let material = r#"{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "baseColorFactor": [1, 0.5, 0.25, 1],
+                      "metallicRoughnessTexture": {"index": 1}, "metallicFactor": 1, "roughnessFactor": 0.5},
+                     "occlusionTexture": {"index": 1}, "alphaMode": "MASK"}"#;
+    let (json, _) = textured_triangle_gltf(material, [png_1x1([188, 188, 188]), png_1x1([255, 102, 51])]);
     let path = dir.join("orm.gltf");
     std::fs::write(&path, &json).unwrap();
     let desc = raylab_loader::parse_any(&path, false).unwrap_or_else(|e| panic!("{e}"));
@@ -289,6 +270,34 @@ fn gltf_metallic_roughness_textures_vary_the_brdf_per_point() {
     assert_cook_torrance(bsdf, base * 0.8, Rgb::splat(0.04) + (base - Rgb::splat(0.04)) * 0.2, 0.04);
 }
 
+/// A glTF of one unit right triangle with UVs, its buffer and two PNG images embedded as
+/// base64 `data:` URIs (textures 0 and 1), and `material` as its only material; returns the
+/// JSON and the buffer's base64 text.
+fn textured_triangle_gltf(material: &str, images: [Vec<u8>; 2]) -> (String, String) {
+    let positions: Vec<u8> = [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    let uvs: Vec<u8> = [[0f32, 1.0], [1.0, 1.0], [0.0, 0.0]].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    let buffer = base64::encode([positions, uvs].concat());
+    let [image0, image1] = images.map(base64::encode);
+    let json = format!(
+        r#"{{
+      "asset": {{"version": "2.0"}},
+      "scenes": [{{"nodes": [0]}}],
+      "nodes": [{{"mesh": 0}}],
+      "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}, "material": 0}}]}}],
+      "materials": [{material}],
+      "textures": [{{"source": 0}}, {{"source": 1}}],
+      "images": [{{"uri": "data:image/png;base64,{image0}"}}, {{"uri": "data:image/png;base64,{image1}"}}],
+      "buffers": [{{"uri": "data:application/octet-stream;base64,{buffer}", "byteLength": 60}}],
+      "bufferViews": [{{"buffer": 0, "byteLength": 36}}, {{"buffer": 0, "byteOffset": 36, "byteLength": 24}}],
+      "accessors": [
+        {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}},
+        {{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}}
+      ]
+    }}"#
+    );
+    (json, buffer)
+}
+
 /// A 1×1 PNG of one 8-bit colour, as exporters embed images.
 fn png_1x1(rgb: [u8; 3]) -> Vec<u8> {
     let mut out = Vec::new();
@@ -303,27 +312,8 @@ fn png_1x1(rgb: [u8; 3]) -> Vec<u8> {
 fn gltf_data_uris_and_normal_textures() {
     let dir = std::env::temp_dir().join(format!("raylab_gltf_data_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let positions: Vec<u8> = [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
-    let uvs: Vec<u8> = [[0f32, 1.0], [1.0, 1.0], [0.0, 0.0]].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
-    let buffer = base64::encode([positions, uvs].concat());
-    let (flat, colour) = (base64::encode(png_1x1([128, 128, 255])), base64::encode(png_1x1([188, 188, 188])));
-    let json = format!(
-        r#"{{
-      "asset": {{"version": "2.0"}},
-      "scenes": [{{"nodes": [0]}}],
-      "nodes": [{{"mesh": 0}}],
-      "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}, "material": 0}}]}}],
-      "materials": [{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}, "metallicFactor": 0}}, "normalTexture": {{"index": 1}}}}],
-      "textures": [{{"source": 0}}, {{"source": 1}}],
-      "images": [{{"uri": "data:image/png;base64,{colour}"}}, {{"uri": "data:image/png;base64,{flat}"}}],
-      "buffers": [{{"uri": "data:application/octet-stream;base64,{buffer}", "byteLength": 60}}],
-      "bufferViews": [{{"buffer": 0, "byteLength": 36}}, {{"buffer": 0, "byteOffset": 36, "byteLength": 24}}],
-      "accessors": [
-        {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}},
-        {{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}}
-      ]
-    }}"#
-    );
+    let material = r#"{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}, "normalTexture": {"index": 1}}"#;
+    let (json, buffer) = textured_triangle_gltf(material, [png_1x1([188, 188, 188]), png_1x1([128, 128, 255])]);
     std::fs::write(dir.join("embedded.gltf"), &json).unwrap();
     let s = load_scene_or_mesh(&dir.join("embedded.gltf"), &Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
     let mesh = &s.geometry.meshes[0];
