@@ -71,6 +71,19 @@ fn read_exr(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Vec<Rgb>), ImageErro
         if bytes.is_none_or(|b| b > (bytes_len as u64).saturating_mul(MAX_EXR_EXPANSION)) {
             return Err(err(path, format!("its {w}×{ht} layer cannot be stored in a file of {bytes_len} bytes")));
         }
+        // The same for one block (a tile or a band of scan lines), which the reader
+        // decompresses whole: a tile can be far larger than its layer.
+        let block = match h.blocks {
+            exr::meta::BlockDescription::Tiles(t) => (t.tile_size.width() as u64).checked_mul(t.tile_size.height() as u64),
+            exr::meta::BlockDescription::ScanLines => Some(h.compression.scan_lines_per_block() as u64 * w as u64),
+        };
+        if block.and_then(|px| px.checked_mul(h.channels.bytes_per_pixel as u64)).is_none_or(|b| b > (bytes_len as u64).saturating_mul(MAX_EXR_EXPANSION)) {
+            let size = match h.blocks {
+                exr::meta::BlockDescription::Tiles(t) => format!("{}×{} tiles", t.tile_size.width(), t.tile_size.height()),
+                exr::meta::BlockDescription::ScanLines => format!("blocks of {} scan lines", h.compression.scan_lines_per_block()),
+            };
+            return Err(err(path, format!("its {size} cannot be stored in a file of {bytes_len} bytes")));
+        }
         raylab_render::memory_guard::check(&format!("its {w}×{ht} layer"), bytes).map_err(|e| err(path, e))?;
     }
     let image = read()
