@@ -338,6 +338,15 @@ impl AnyAccel {
         }
     }
 
+    /// The kernel of a wide BVH; `None` for other structures.
+    pub fn kernel(&self) -> Option<Kernel> {
+        match self {
+            AnyAccel::Bvh8(a) => Some(a.kernel()),
+            AnyAccel::Bvh4(a) => Some(a.kernel()),
+            _ => None,
+        }
+    }
+
     /// Forces the kernel of a wide BVH (no effect on other structures): tests compare the
     /// SIMD and portable kernels.
     pub fn with_kernel(self, k: Kernel) -> Self {

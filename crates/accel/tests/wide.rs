@@ -8,9 +8,14 @@ use raylab_testkit::{self as kit, Soup};
 
 const WIDE: [AccelKind; 3] = [AccelKind::Bvh8, AccelKind::Bvh4, AccelKind::Bvh8Sbvh];
 
+/// The SIMD kernels each test against the portable one (on a CPU without AVX-512,
+/// `Avx512` falls back to `Simd` and the pair is tested twice).
+const SIMD_KERNELS: [Kernel; 2] = [Kernel::Simd, Kernel::Avx512];
+
 fn check_kernels_agree(name: &str, soup: &Soup, rays: &[Ray]) {
-    for kind in WIDE {
-        let simd = AnyAccel::build(kind, soup, &BuildOptions::default()).with_kernel(Kernel::Simd);
+    for (kind, kernel) in WIDE.into_iter().flat_map(|k| SIMD_KERNELS.map(|s| (k, s))) {
+        let name = &format!("{name}/{kernel:?}");
+        let simd = AnyAccel::build(kind, soup, &BuildOptions::default()).with_kernel(kernel);
         let portable = AnyAccel::build(kind, soup, &BuildOptions::default()).with_kernel(Kernel::Portable);
         portable.validate(soup).unwrap_or_else(|e| panic!("{name}/{kind}: {e}"));
         let (mut cs, mut cp) = (Counters::default(), Counters::default());
@@ -88,7 +93,7 @@ fn watertight_from_inside_the_cube() {
     let mut rng = Pcg32::new(23, 1);
     let corners: Vec<Vec3> = (0..8).map(|k| Vec3::new((k & 1) as f32, ((k >> 1) & 1) as f32, ((k >> 2) & 1) as f32) - 0.5).collect();
     for kind in WIDE {
-        for kernel in [Kernel::Simd, Kernel::Portable] {
+        for kernel in [Kernel::Avx512, Kernel::Simd, Kernel::Portable] {
             let accel = AnyAccel::build(kind, &soup, &BuildOptions::default()).with_kernel(kernel);
             for _ in 0..2000 {
                 let o = kit::random_point(&mut rng, &Aabb::new(Vec3::splat(-0.4), Vec3::splat(0.4)));
@@ -115,7 +120,7 @@ fn oversized_binary_leaf_is_split() {
     let soup = kit::random_triangles(&mut rng, 300, &unit, 0.2);
     let bin = Bvh::from_parts(vec![BvhNode::leaf(soup.bounds(), 0, 300)], (0..300).collect(), 300, "one leaf");
     let oracle = AnyAccel::build(AccelKind::None, &soup, &BuildOptions::default());
-    for kernel in [Kernel::Simd, Kernel::Portable] {
+    for kernel in [Kernel::Avx512, Kernel::Simd, Kernel::Portable] {
         let wide = WideBvh::<8>::from_binary(&bin, &soup, "bvh8").with_kernel(kernel);
         wide.validate(&soup).unwrap();
         assert!(!wide.nodes.is_empty(), "the leaf was not split");
@@ -130,8 +135,9 @@ fn oversized_binary_leaf_is_split() {
 /// exactly the single-ray one (same primitive, distance and barycentrics).
 fn check_packets_match_single(name: &str, soup: &Soup, rays: &[Ray]) -> usize {
     let mut hits = 0;
-    for kind in WIDE {
-        let simd = AnyAccel::build(kind, soup, &BuildOptions::default()).with_kernel(Kernel::Simd);
+    for (kind, kernel) in WIDE.into_iter().flat_map(|k| SIMD_KERNELS.map(|s| (k, s))) {
+        let name = &format!("{name}/{kernel:?}");
+        let simd = AnyAccel::build(kind, soup, &BuildOptions::default()).with_kernel(kernel);
         let portable = AnyAccel::build(kind, soup, &BuildOptions::default()).with_kernel(Kernel::Portable);
         for (p, packet) in rays.chunks(PACKET).enumerate() {
             let (mut s, mut q) = (vec![None; packet.len()], vec![None; packet.len()]);
@@ -179,7 +185,8 @@ fn packets_answer_as_single_rays_coherent_and_incoherent() {
     let eye = centre + Vec3::new(0.3, 0.2, 2.5) * b.extent().max_element();
     let tiles = camera_tiles(eye, centre, 0.6, 64);
     let hits = check_packets_match_single("bunny tiles", &bunny, &tiles);
-    assert!(hits > 3 * 1000 && hits < 3 * 64 * 64, "tiles should both hit and miss: {hits} hits");
+    let runs = WIDE.len() * SIMD_KERNELS.len();
+    assert!(hits > runs * 1000 && hits < runs * 64 * 64, "tiles should both hit and miss: {hits} hits");
     // Incoherent packets: random origins and directions, and a packet of rays that all miss.
     let mut rng = Pcg32::new(25, 1);
     let mut rays = kit::random_rays(&mut rng, 1600, &Aabb::new(b.min - b.extent(), b.max + b.extent()), &b);
@@ -197,7 +204,7 @@ fn packets_answer_as_single_rays_coherent_and_incoherent() {
         ties.push(Ray::new(o, (0.5 * (a + c) - o).try_normalize().unwrap_or(Vec3::X)));
     }
     let cube = kit::cube();
-    assert_eq!(check_packets_match_single("cube edges", &cube, &ties), 3 * ties.len(), "every ray from inside hits");
+    assert_eq!(check_packets_match_single("cube edges", &cube, &ties), runs * ties.len(), "every ray from inside hits");
 }
 
 /// Packets in an empty scene, of one ray, and of no rays.

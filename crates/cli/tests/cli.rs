@@ -180,6 +180,15 @@ fn bench_agrees_with_the_oracle_and_trace_reproduces_it() {
     let t: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!((&t["hits"], &t["t_sum"], &t["packet"]), (&oracle["hits"], &oracle["t_sum"], &serde_json::json!(16)));
     fails_with(&["trace", cube.to_str().unwrap(), "--rays", "rays/cube-primary.rays", "--packet", "16", "--any-hit"], &dir, "--packet traces closest hits only: drop --any-hit or --packet");
+    // Every kernel of the wide BVHs gives the same answers; the JSON says which one ran.
+    for kernel in ["portable", "simd", "avx512"] {
+        let o = raylab(&["trace", cube.to_str().unwrap(), "--rays", "rays/cube-primary.rays", "--accel", "bvh8", "--kernel", kernel, "--json"], &dir);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let t: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!((&t["hits"], &t["t_sum"]), (&oracle["hits"], &oracle["t_sum"]), "--kernel {kernel}");
+        let ran = t["kernel"].as_str().unwrap();
+        assert!(ran == kernel || (kernel == "avx512" && ran == "simd"), "--kernel {kernel} ran {ran}");
+    }
 }
 
 #[test]

@@ -200,6 +200,95 @@ pub fn triangle_candidates_sse(b: &TriBlock, s: &ShearedRay) -> u32 {
     keep
 }
 
+/// The watertight kernel's answers for the four lanes of a block ([`triangles_sse`]).
+#[derive(Clone, Copy, Debug)]
+pub struct BlockHits {
+    /// Lanes hit within `(t_min, t_max]`, with their distance and barycentrics below.
+    pub hit: u32,
+    /// Lanes the four-wide arithmetic leaves to the scalar kernel: an edge function exactly
+    /// zero or not a number (the scalar kernel recomputes them in double precision), a
+    /// distance within its error bound of zero or not finite (its double-precision
+    /// fallback), and primitives that are not triangles ([`TriBlock::OTHER`]).
+    pub exact: u32,
+    pub t: [f32; 4],
+    pub u: [f32; 4],
+    pub v: [f32; 4],
+}
+
+/// [`ShearedRay::triangle`] on the four lanes of a block at once (SSE2): the same IEEE
+/// operations in the same order (no FMA), so a lane it decides gets exactly the scalar
+/// kernel's `t` and barycentrics; the rare lanes it cannot decide are flagged
+/// [`BlockHits::exact`]. The traversal then makes no call for most blocks, and a call is
+/// what forces the compiler to spill the ray's constants from the vector registers.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub fn triangles_sse(b: &TriBlock, s: &ShearedRay, t_min: f32, t_max: f32) -> BlockHits {
+    use std::arch::x86_64::*;
+    let (kx, ky, kz) = (s.kx, s.ky, s.kz);
+    // SAFETY: SSE2 is in the x86-64 baseline; every row holds 4 f32 and `prim` 4 u32.
+    unsafe {
+        let (ox, oy, oz) = (_mm_set1_ps(s.origin[kx]), _mm_set1_ps(s.origin[ky]), _mm_set1_ps(s.origin[kz]));
+        let (sx, sy, sz) = (_mm_set1_ps(s.sx), _mm_set1_ps(s.sy), _mm_set1_ps(s.sz));
+        // Per vertex: sheared x, y, and the depth `a[kz]` before scaling.
+        let project = |v: usize| {
+            let az = _mm_sub_ps(_mm_loadu_ps(b.p[v][kz].as_ptr()), oz);
+            let x = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(b.p[v][kx].as_ptr()), ox), _mm_mul_ps(sx, az));
+            let y = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(b.p[v][ky].as_ptr()), oy), _mm_mul_ps(sy, az));
+            (x, y, az)
+        };
+        let ((ax, ay, az), (bx, by, bz), (cx, cy, cz)) = (project(0), project(1), project(2));
+        let u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
+        let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
+        let w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
+        let zero = _mm_setzero_ps();
+        let undecided_edges = _mm_or_ps(
+            _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)), _mm_cmpeq_ps(w, zero)),
+            _mm_or_ps(_mm_cmpunord_ps(u, v), _mm_cmpunord_ps(w, w)),
+        );
+        let neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)), _mm_cmplt_ps(w, zero));
+        let pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)), _mm_cmpgt_ps(w, zero));
+        let outside = _mm_and_ps(neg, pos);
+        let det = _mm_add_ps(_mm_add_ps(u, v), w);
+        let (az, bz, cz) = (_mm_mul_ps(sz, az), _mm_mul_ps(sz, bz), _mm_mul_ps(sz, cz));
+        let t_scaled = _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, az), _mm_mul_ps(v, bz)), _mm_mul_ps(w, cz));
+        let inv_det = _mm_div_ps(_mm_set1_ps(1.0), det);
+        let t = _mm_mul_ps(t_scaled, inv_det);
+        // pbrt-v4's error bound on t, as `raylab_core::intersect::t_error_bound` writes it.
+        let sign = _mm_set1_ps(-0.0);
+        let abs = |x: __m128| _mm_andnot_ps(sign, x);
+        let max3 = |a: __m128, b: __m128, c: __m128| _mm_max_ps(_mm_max_ps(abs(a), abs(b)), abs(c));
+        let (max_zt, max_xt, max_yt, max_e) = (max3(az, bz, cz), max3(ax, bx, cx), max3(ay, by, cy), max3(u, v, w));
+        let g = |n: u32| _mm_set1_ps(raylab_core::gamma(n));
+        let delta_z = _mm_mul_ps(g(3), max_zt);
+        let delta_x = _mm_mul_ps(g(5), _mm_add_ps(max_xt, max_zt));
+        let delta_y = _mm_mul_ps(g(5), _mm_add_ps(max_yt, max_zt));
+        let delta_e = _mm_mul_ps(_mm_set1_ps(2.0), _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_mul_ps(g(2), max_xt), max_yt), _mm_mul_ps(delta_y, max_xt)), _mm_mul_ps(delta_x, max_yt)));
+        let delta_t = _mm_mul_ps(
+            _mm_mul_ps(_mm_set1_ps(3.0), _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_mul_ps(g(3), max_e), max_zt), _mm_mul_ps(delta_e, max_zt)), _mm_mul_ps(delta_z, max_e))),
+            abs(inv_det),
+        );
+        // `abs < ∞` is false for NaN too.
+        let inf = _mm_set1_ps(f32::INFINITY);
+        let finite = _mm_and_ps(_mm_cmplt_ps(abs(t), inf), _mm_cmplt_ps(abs(delta_t), inf));
+        let ahead = _mm_cmpgt_ps(t, delta_t);
+        let behind = _mm_cmplt_ps(t, _mm_xor_ps(delta_t, sign));
+        // Lanes the edge functions reject (as the scalar kernel: outside, or a zero determinant).
+        let rejected = _mm_andnot_ps(undecided_edges, _mm_or_ps(outside, _mm_cmpeq_ps(det, zero)));
+        let decided_t = _mm_and_ps(finite, _mm_or_ps(ahead, behind));
+        let in_range = _mm_and_ps(_mm_cmpgt_ps(t, _mm_set1_ps(t_min)), _mm_cmple_ps(t, _mm_set1_ps(t_max)));
+        let hit = _mm_andnot_ps(_mm_or_ps(undecided_edges, rejected), _mm_and_ps(_mm_and_ps(finite, ahead), in_range));
+        let exact = _mm_or_ps(undecided_edges, _mm_andnot_ps(_mm_or_ps(rejected, decided_t), _mm_set1_ps(f32::from_bits(u32::MAX))));
+        let prim = _mm_loadu_si128(b.prim.as_ptr().cast());
+        let empty = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(prim, _mm_set1_epi32(EMPTY as i32)))) as u32;
+        let other = _mm_movemask_ps(_mm_castsi128_ps(prim)) as u32 & !empty;
+        let mut out = BlockHits { hit: (_mm_movemask_ps(hit) as u32) & !empty & !other, exact: ((_mm_movemask_ps(exact) as u32) | other) & !empty, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
+        _mm_storeu_ps(out.t.as_mut_ptr(), t);
+        _mm_storeu_ps(out.u.as_mut_ptr(), _mm_mul_ps(v, inv_det));
+        _mm_storeu_ps(out.v.as_mut_ptr(), _mm_mul_ps(w, inv_det));
+        out
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -311,5 +400,74 @@ mod tests {
             let s = ShearedRay::new(&ray);
             assert_eq!(triangle_candidates_sse(&b, &s), triangle_candidates(&b, &s), "block {k}");
         }
+    }
+
+    /// The four-wide kernel decides each lane exactly as the scalar kernel does (same `t`
+    /// and barycentrics to the bit) or hands it to the scalar kernel: on random triangles,
+    /// degenerate ones (zero area, a vertex at the origin: zero edge functions), tiny,
+    /// huge and overflowing coordinates, rays starting on the triangles (t within the error
+    /// bound), and `t` ranges that cut hits off.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn sse_triangle_kernel_matches_the_scalar_kernel() {
+        let mut rng = raylab_core::Pcg32::new(7, 1);
+        let mut r = |scale: f32| Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, rng.next_f32() - 0.5) * scale;
+        let (mut hits, mut exact) = (0, 0);
+        for k in 0..40000 {
+            let scale = [1.0, 1e-30, 1e30, 3e38, 1e6][(k / 4) % 5];
+            let mut b = TriBlock::EMPTY_BLOCK;
+            let lanes = k % 4 + 1;
+            for l in 0..lanes {
+                let v = match (k + l) % 6 {
+                    0 => [Vec3::ZERO; 3],
+                    1 => {
+                        let p = r(scale);
+                        [p, p, r(scale)]
+                    }
+                    _ => [r(scale), r(scale), r(scale)],
+                };
+                b.set_triangle(l, l as u32, v);
+            }
+            if k % 7 == 0 {
+                b.prim[0] = 3 | TriBlock::OTHER;
+            }
+            // Origins: the origin, random, or on a lane's triangle (t ≈ 0).
+            let o = match k % 3 {
+                0 => Vec3::ZERO,
+                1 => r(2.0 * scale),
+                _ => {
+                    let (p0, p1, p2) = (b.vertex(lanes - 1, 0), b.vertex(lanes - 1, 1), b.vertex(lanes - 1, 2));
+                    p0 + 0.3 * (p1 - p0) + 0.3 * (p2 - p0)
+                }
+            };
+            let target = b.vertex(k % lanes, 0) / 3.0 + b.vertex(k % lanes, 1) / 3.0 + b.vertex(k % lanes, 2) / 3.0 + r(0.1 * scale);
+            let d = (target - o).try_normalize().unwrap_or(Vec3::Z);
+            let ray = Ray::new(o, if k % 11 == 0 { -d } else { d });
+            let s = ShearedRay::new(&ray);
+            let (t_min, t_max) = if k % 5 == 0 { (0.0, 0.5 * scale) } else { (0.0, f32::INFINITY) };
+            let h = triangles_sse(&b, &s, t_min, t_max);
+            assert_eq!(h.hit & h.exact, 0, "block {k}: a lane both decided and not");
+            for l in 0..4 {
+                let bit = 1 << l;
+                let p = b.prim[l];
+                if p == EMPTY {
+                    assert_eq!((h.hit | h.exact) & bit, 0, "block {k}: empty lane {l}");
+                    continue;
+                }
+                if p & TriBlock::OTHER != 0 {
+                    assert_ne!(h.exact & bit, 0, "block {k}: a non-triangle lane {l} must go to its own test");
+                    continue;
+                }
+                let scalar = s.triangle(t_min, t_max, b.vertex(l, 0), b.vertex(l, 1), b.vertex(l, 2));
+                if h.exact & bit != 0 {
+                    exact += 1;
+                    continue;
+                }
+                let simd = (h.hit & bit != 0).then(|| (h.t[l], h.u[l], h.v[l]));
+                assert_eq!(simd.map(|(t, u, v)| [t, u, v].map(f32::to_bits)), scalar.map(|(t, u, v)| [t, u, v].map(f32::to_bits)), "block {k} lane {l}");
+                hits += usize::from(simd.is_some());
+            }
+        }
+        assert!(hits > 3000 && exact > 100, "too few cases of each kind: {hits} hits, {exact} left to the scalar kernel");
     }
 }

@@ -24,22 +24,35 @@ use node::{is_leaf, leaf_blocks, ChildRef, TriBlock, WideNode, EMPTY};
 pub use collapse::LEAF_PRIMS;
 pub use packet::PACKET;
 
-/// Which kernels a traversal runs.
+/// Which kernels a traversal runs. All give bit-identical answers (the tests compare them).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kernel {
     /// Plain Rust, on any CPU.
     Portable,
     /// `std::arch`: AVX2 for 8-wide nodes, SSE2 for 4-wide (x86-64 only).
     Simd,
+    /// The same intrinsics with the whole traversal compiled for AVX-512F/VL: 32 vector
+    /// registers instead of 16 and mask registers for the compares. Same IEEE operations
+    /// in the same order, so the same answers.
+    Avx512,
 }
 
 impl Kernel {
     /// The fastest kernel this CPU runs for width `w` (runtime detection: the binary stays
     /// portable, no `target-cpu` needed).
     pub fn detect(w: usize) -> Kernel {
+        Kernel::Avx512.available(w)
+    }
+
+    /// `self` if this CPU runs it for width `w`, else the next best that it runs.
+    pub fn available(self, w: usize) -> Kernel {
         #[cfg(target_arch = "x86_64")]
         {
-            if w == 4 || (w == 8 && std::is_x86_feature_detected!("avx2")) {
+            use std::is_x86_feature_detected as has;
+            if self == Kernel::Avx512 && has!("avx512f") && has!("avx512vl") && has!("avx2") && has!("bmi1") && has!("bmi2") {
+                return Kernel::Avx512;
+            }
+            if self != Kernel::Portable && (w == 4 || (w == 8 && has!("avx2"))) {
                 return Kernel::Simd;
             }
         }
@@ -74,10 +87,10 @@ impl<const W: usize> WideBvh<W> {
         Self { nodes: c.nodes, blocks: c.blocks, root: c.root, root_bounds: c.root_bounds, name, build_ms: 0.0, primitives: prims.len(), spatial_splits: bvh.spatial_splits, kernel: Kernel::detect(W) }
     }
 
-    /// Forces a kernel (tests compare the SIMD and portable ones). Asking for
-    /// [`Kernel::Simd`] on a CPU without it keeps the portable one.
+    /// Forces a kernel (tests compare them). Asking for one this CPU lacks gives the next
+    /// best it has ([`Kernel::available`]).
     pub fn with_kernel(mut self, k: Kernel) -> Self {
-        self.kernel = if k == Kernel::Simd { Kernel::detect(W) } else { k };
+        self.kernel = k.available(W);
         self
     }
 
@@ -108,12 +121,13 @@ impl<const W: usize> WideBvh<W> {
     /// If `rays` holds more than [`PACKET`] rays or `out` is not as long as `rays`.
     pub fn intersect_packet<P: Primitives + ?Sized>(&self, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
         #[cfg(target_arch = "x86_64")]
-        if self.kernel == Kernel::Simd {
-            if W == 8 {
-                // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
-                return unsafe { packet_avx2::<P, W>(self, prims, rays, out) };
-            }
-            return packet::closest::<P, W, true>(self, prims, rays, out);
+        match self.kernel {
+            // SAFETY: `Kernel::Avx512` is only chosen after detecting its features.
+            Kernel::Avx512 => return unsafe { packet_avx512::<P, W>(self, prims, rays, out) },
+            // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
+            Kernel::Simd if W == 8 => return unsafe { packet_avx2::<P, W>(self, prims, rays, out) },
+            Kernel::Simd => return packet::closest::<P, W, true>(self, prims, rays, out),
+            Kernel::Portable => {}
         }
         packet::closest::<P, W, false>(self, prims, rays, out)
     }
@@ -121,12 +135,13 @@ impl<const W: usize> WideBvh<W> {
     #[inline]
     fn closest_dispatch<P: Primitives + ?Sized, const COUNT: bool>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
         #[cfg(target_arch = "x86_64")]
-        if self.kernel == Kernel::Simd {
-            if W == 8 {
-                // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
-                return unsafe { closest_avx2::<P, W, COUNT>(self, prims, ray, c) };
-            }
-            return traverse::closest::<P, W, true, COUNT>(self, prims, ray, c);
+        match self.kernel {
+            // SAFETY: `Kernel::Avx512` is only chosen after detecting its features.
+            Kernel::Avx512 => return unsafe { closest_avx512::<P, W, COUNT>(self, prims, ray, c) },
+            // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
+            Kernel::Simd if W == 8 => return unsafe { closest_avx2::<P, W, COUNT>(self, prims, ray, c) },
+            Kernel::Simd => return traverse::closest::<P, W, true, COUNT>(self, prims, ray, c),
+            Kernel::Portable => {}
         }
         traverse::closest::<P, W, false, COUNT>(self, prims, ray, c)
     }
@@ -134,12 +149,13 @@ impl<const W: usize> WideBvh<W> {
     #[inline]
     fn any_dispatch<P: Primitives + ?Sized, const COUNT: bool>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
         #[cfg(target_arch = "x86_64")]
-        if self.kernel == Kernel::Simd {
-            if W == 8 {
-                // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
-                return unsafe { any_avx2::<P, W, COUNT>(self, prims, ray, c) };
-            }
-            return traverse::any::<P, W, true, COUNT>(self, prims, ray, c);
+        match self.kernel {
+            // SAFETY: `Kernel::Avx512` is only chosen after detecting its features.
+            Kernel::Avx512 => return unsafe { any_avx512::<P, W, COUNT>(self, prims, ray, c) },
+            // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
+            Kernel::Simd if W == 8 => return unsafe { any_avx2::<P, W, COUNT>(self, prims, ray, c) },
+            Kernel::Simd => return traverse::any::<P, W, true, COUNT>(self, prims, ray, c),
+            Kernel::Portable => {}
         }
         traverse::any::<P, W, false, COUNT>(self, prims, ray, c)
     }
@@ -186,6 +202,26 @@ unsafe fn packet_avx2<P: Primitives + ?Sized, const W: usize>(bvh: &WideBvh<W>, 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn any_avx2<P: Primitives + ?Sized, const W: usize, const COUNT: bool>(bvh: &WideBvh<W>, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
+    traverse::any::<P, W, true, COUNT>(bvh, prims, ray, c)
+}
+
+/// The AVX-512 instantiations: the same code as the AVX2 ones (the AVX2 and SSE2
+/// intrinsics inline into them), given 32 vector registers, mask registers and BMI.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,avx512f,avx512vl,bmi1,bmi2")]
+unsafe fn closest_avx512<P: Primitives + ?Sized, const W: usize, const COUNT: bool>(bvh: &WideBvh<W>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
+    traverse::closest::<P, W, true, COUNT>(bvh, prims, ray, c)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,avx512f,avx512vl,bmi1,bmi2")]
+unsafe fn packet_avx512<P: Primitives + ?Sized, const W: usize>(bvh: &WideBvh<W>, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
+    packet::closest::<P, W, true>(bvh, prims, rays, out)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,avx512f,avx512vl,bmi1,bmi2")]
+unsafe fn any_avx512<P: Primitives + ?Sized, const W: usize, const COUNT: bool>(bvh: &WideBvh<W>, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
     traverse::any::<P, W, true, COUNT>(bvh, prims, ray, c)
 }
 

@@ -17,10 +17,10 @@ use raylab_core::Ray;
 #[cfg(target_arch = "x86_64")]
 use super::kernels::slabs_avx2;
 use super::kernels::{RayBoxes, ROBUST_FAR};
-use super::node::{is_leaf, ChildRef, TriBlock, WideNode, EMPTY};
-use super::traverse::{candidates, child_boxes, leaf_slice, wins, STACK};
+use super::node::{is_leaf, ChildRef, WideNode, EMPTY};
+use super::traverse::{block_closest, child_boxes, leaf_slice, STACK};
 use super::WideBvh;
-use crate::{Hit, PrimHit, Primitives};
+use crate::{Hit, Primitives};
 
 /// Rays per packet: a 4×4 tile, one bit each in a [`RayMask`].
 pub const PACKET: usize = 16;
@@ -56,8 +56,8 @@ fn node_boxes<const W: usize, const SIMD: bool>(node: &WideNode<W>, rb: &[RayBox
     #[cfg(target_arch = "x86_64")]
     if SIMD && W == 8 {
         // SAFETY: `W == 8`, so these are the same types; SIMD = true with W = 8 is only
-        // instantiated inside `#[target_feature(enable = "avx2")]` functions that the
-        // build selects after `is_x86_feature_detected!("avx2")`.
+        // instantiated inside functions with AVX2 enabled (`packet_avx2`, `packet_avx512`)
+        // that `Kernel::available` selects after detecting their features.
         return unsafe {
             node_boxes_avx2(&*(node as *const WideNode<W>).cast::<WideNode<8>>(), rb, far, active, &mut *(entered as *mut [RayMask; W]).cast::<[RayMask; 8]>(), &mut *(nearest as *mut [f32; W]).cast::<[f32; 8]>())
         };
@@ -128,26 +128,8 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, const SIMD: bool>(
         if is_leaf(cur) {
             for b in leaf_slice(bvh, cur) {
                 for r in bits(active) {
-                    let s = &sheared[r];
-                    let mut m = candidates::<SIMD>(b, s);
-                    while m != 0 {
-                        let l = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        let p = b.prim[l];
-                        let prim = p & !TriBlock::OTHER;
-                        let hit = if p & TriBlock::OTHER != 0 {
-                            prims.intersect(prim, &ray[r])
-                        } else {
-                            s.triangle(ray[r].t_min, ray[r].t_max, b.vertex(l, 0), b.vertex(l, 1), b.vertex(l, 2)).map(|(t, u, v)| PrimHit { t, u, v })
-                        };
-                        if let Some(h) = hit {
-                            if wins(h.t, prim, &out[r]) {
-                                ray[r].t_max = h.t;
-                                far[r] = h.t * ROBUST_FAR;
-                                out[r] = Some(Hit::new(prim, h));
-                            }
-                        }
-                    }
+                    block_closest::<P, SIMD>(b, prims, &sheared[r], &mut ray[r], &mut out[r]);
+                    far[r] = ray[r].t_max * ROBUST_FAR;
                 }
             }
         } else {

@@ -14,15 +14,6 @@ use raylab_core::Ray;
 
 use super::kernels::{boxes_portable, triangle_candidates, RayBoxes, ROBUST_FAR};
 
-/// The triangle filter of the kernel in use (SSE2 on x86-64 for both SIMD widths).
-#[inline(always)]
-pub(super) fn candidates<const SIMD: bool>(b: &TriBlock, s: &ShearedRay) -> u32 {
-    #[cfg(target_arch = "x86_64")]
-    if SIMD {
-        return super::kernels::triangle_candidates_sse(b, s);
-    }
-    triangle_candidates(b, s)
-}
 use super::node::{is_leaf, leaf_blocks, ChildRef, TriBlock, WideNode, EMPTY};
 use super::WideBvh;
 use crate::{Counters, Hit, PrimHit, Primitives};
@@ -51,8 +42,8 @@ pub(super) fn child_boxes<const W: usize, const SIMD: bool>(node: &WideNode<W>, 
     if SIMD {
         if W == 8 {
             // SAFETY: `W == 8`, so these are the same types; SIMD = true with W = 8 is only
-            // instantiated inside `#[target_feature(enable = "avx2")]` functions that the
-            // build selects after `is_x86_feature_detected!("avx2")`.
+            // instantiated inside functions with AVX2 enabled (`closest_avx2`, `closest_avx512`,
+            // ...) that `Kernel::available` selects after detecting their features.
             return unsafe { super::kernels::boxes_avx2(&*(node as *const WideNode<W>).cast::<WideNode<8>>(), r, t_max, &mut *(tnear as *mut [f32; W]).cast::<[f32; 8]>()) };
         }
         if W == 4 {
@@ -73,31 +64,93 @@ pub(super) fn wins(t: f32, prim: u32, best: &Option<Hit>) -> bool {
     best.is_none_or(|b| t < b.t || prim < b.prim)
 }
 
+/// The closest hit among the lanes of block `b`, if nearer than `best` (ties to the lower
+/// primitive); moves `ray.t_max` to it. With SIMD the four triangles are tested at once
+/// ([`triangles_sse`](super::kernels::triangles_sse)) and only the lanes it cannot decide
+/// take a call.
+#[inline(always)]
+pub(super) fn block_closest<P: Primitives + ?Sized, const SIMD: bool>(b: &TriBlock, prims: &P, s: &ShearedRay, ray: &mut Ray, best: &mut Option<Hit>) {
+    #[cfg(target_arch = "x86_64")]
+    if SIMD {
+        let h = super::kernels::triangles_sse(b, s, ray.t_min, ray.t_max);
+        let mut m = h.hit | h.exact;
+        while m != 0 {
+            let l = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let found = if h.hit & (1 << l) != 0 { Some(PrimHit { t: h.t[l], u: h.u[l], v: h.v[l] }) } else { exact_lane(b, l, prims, s, ray) };
+            let prim = b.prim[l] & !TriBlock::OTHER;
+            // Lanes were tested against the `t_max` the block started with.
+            if let Some(x) = found.filter(|x| x.t <= ray.t_max && wins(x.t, prim, best)) {
+                ray.t_max = x.t;
+                *best = Some(Hit::new(prim, x));
+            }
+        }
+        return;
+    }
+    let mut m = triangle_candidates(b, s);
+    while m != 0 {
+        let l = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let prim = b.prim[l] & !TriBlock::OTHER;
+        if let Some(x) = exact_lane(b, l, prims, s, ray).filter(|x| wins(x.t, prim, best)) {
+            ray.t_max = x.t;
+            *best = Some(Hit::new(prim, x));
+        }
+    }
+}
+
+/// Whether any lane of block `b` is hit (see [`block_closest`]).
+#[inline(always)]
+fn block_any<P: Primitives + ?Sized, const SIMD: bool>(b: &TriBlock, prims: &P, s: &ShearedRay, ray: &Ray) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    let mut m = if SIMD {
+        let h = super::kernels::triangles_sse(b, s, ray.t_min, ray.t_max);
+        if h.hit != 0 {
+            return true;
+        }
+        h.exact
+    } else {
+        triangle_candidates(b, s)
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let mut m = triangle_candidates(b, s);
+    while m != 0 {
+        let l = m.trailing_zeros() as usize;
+        m &= m - 1;
+        if exact_lane(b, l, prims, s, ray).is_some() {
+            return true;
+        }
+    }
+    false
+}
+
+/// Lane `l` of `b` through the scalar kernel: the watertight triangle test with its
+/// double-precision fallbacks, or the primitive's own test. Kept out of line: the
+/// traversal's registers are spilled only on this (with SIMD, rare) path.
+#[inline(never)]
+fn exact_lane<P: Primitives + ?Sized>(b: &TriBlock, l: usize, prims: &P, s: &ShearedRay, ray: &Ray) -> Option<PrimHit> {
+    let p = b.prim[l];
+    if p & TriBlock::OTHER != 0 {
+        prims.intersect(p & !TriBlock::OTHER, ray)
+    } else {
+        s.triangle(ray.t_min, ray.t_max, b.vertex(l, 0), b.vertex(l, 1), b.vertex(l, 2)).map(|(t, u, v)| PrimHit { t, u, v })
+    }
+}
+
+/// Occupied lanes of a block (what the counting build charges as primitive tests).
+#[inline(always)]
+fn occupied(b: &TriBlock) -> u64 {
+    b.prim.iter().filter(|&&p| p != EMPTY).count() as u64
+}
+
 /// Closest hit among the blocks of a leaf; moves `ray.t_max` to each hit found.
 #[inline(always)]
 fn leaf_closest<P: Primitives + ?Sized, const SIMD: bool, const COUNT: bool>(blocks: &[TriBlock], prims: &P, s: &ShearedRay, ray: &mut Ray, best: &mut Option<Hit>, w: &mut Work) {
     for b in blocks {
-        let mut m = candidates::<SIMD>(b, s);
         if COUNT {
-            w.tests += b.prim.iter().filter(|&&p| p != EMPTY).count() as u64;
+            w.tests += occupied(b);
         }
-        while m != 0 {
-            let l = m.trailing_zeros() as usize;
-            m &= m - 1;
-            let p = b.prim[l];
-            let hit = if p & TriBlock::OTHER != 0 {
-                prims.intersect(p & !TriBlock::OTHER, ray)
-            } else {
-                s.triangle(ray.t_min, ray.t_max, b.vertex(l, 0), b.vertex(l, 1), b.vertex(l, 2)).map(|(t, u, v)| PrimHit { t, u, v })
-            };
-            if let Some(h) = hit {
-                let prim = p & !TriBlock::OTHER;
-                if wins(h.t, prim, best) {
-                    ray.t_max = h.t;
-                    *best = Some(Hit::new(prim, h));
-                }
-            }
-        }
+        block_closest::<P, SIMD>(b, prims, s, ray, best);
     }
 }
 
@@ -105,22 +158,11 @@ fn leaf_closest<P: Primitives + ?Sized, const SIMD: bool, const COUNT: bool>(blo
 #[inline(always)]
 fn leaf_any<P: Primitives + ?Sized, const SIMD: bool, const COUNT: bool>(blocks: &[TriBlock], prims: &P, s: &ShearedRay, ray: &Ray, w: &mut Work) -> bool {
     for b in blocks {
-        let mut m = candidates::<SIMD>(b, s);
         if COUNT {
-            w.tests += b.prim.iter().filter(|&&p| p != EMPTY).count() as u64;
+            w.tests += occupied(b);
         }
-        while m != 0 {
-            let l = m.trailing_zeros() as usize;
-            m &= m - 1;
-            let p = b.prim[l];
-            let hit = if p & TriBlock::OTHER != 0 {
-                prims.intersect(p & !TriBlock::OTHER, ray).is_some()
-            } else {
-                s.triangle(ray.t_min, ray.t_max, b.vertex(l, 0), b.vertex(l, 1), b.vertex(l, 2)).is_some()
-            };
-            if hit {
-                return true;
-            }
+        if block_any::<P, SIMD>(b, prims, s, ray) {
+            return true;
         }
     }
     false

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, BuildQuality};
+use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, BuildQuality, Kernel};
 use raylab_loader::Overrides;
 
 #[derive(Args, Clone, Debug)]
@@ -36,9 +36,24 @@ pub struct TraceArgs {
     /// other structures trace the packet's rays one by one)
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=raylab_accel::PACKET as i64))]
     pub packet: Option<u32>,
+    /// Kernels of the wide BVHs (bvh4, bvh8, bvh8-sbvh): the fastest this CPU runs, or one
+    /// forced to compare them (a kernel the CPU lacks falls back to the next best; all
+    /// give the same answers)
+    #[arg(long, default_value = "auto", value_enum)]
+    pub kernel: KernelArg,
     /// Print JSON
     #[arg(long)]
     pub json: bool,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KernelArg {
+    Auto,
+    Portable,
+    /// AVX2 for 8-wide nodes, SSE2 for 4-wide
+    Simd,
+    /// The SIMD kernels compiled for AVX-512F/VL (32 vector registers)
+    Avx512,
 }
 
 pub fn run(a: &TraceArgs) -> Result<()> {
@@ -54,7 +69,14 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     let pool = b.build()?;
     pool.install(|| -> Result<()> {
         let scene = raylab_loader::load_scene_or_mesh(&a.scene, &Overrides { accel: Some(AccelKind::None), ..Default::default() })?;
-        let accel = AnyAccel::build(kind, &scene.geometry, &BuildOptions { quality: a.build_quality, ..Default::default() });
+        let mut accel = AnyAccel::build(kind, &scene.geometry, &BuildOptions { quality: a.build_quality, ..Default::default() });
+        accel = match a.kernel {
+            KernelArg::Auto => accel,
+            KernelArg::Portable => accel.with_kernel(Kernel::Portable),
+            KernelArg::Simd => accel.with_kernel(Kernel::Simd),
+            KernelArg::Avx512 => accel.with_kernel(Kernel::Avx512),
+        };
+        let kernel = accel.kernel().map_or("-".to_string(), |k| format!("{k:?}").to_lowercase());
         let build_ms = accel.stats().build_ms;
         let mut results = Vec::new();
         for _ in 0..=a.repeats {
@@ -72,7 +94,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
         if a.json {
             println!(
                 "{}",
-                serde_json::json!({ "rays": r.count, "hits": r.hits, "t_sum": r.t_sum, "seconds": seconds, "mrays_per_s": mrays, "accel": kind.name(), "build_quality": a.build_quality.name(), "build_ms": build_ms, "any_hit": a.any_hit, "packet": a.packet.unwrap_or(1), "threads": rayon::current_num_threads() })
+                serde_json::json!({ "rays": r.count, "hits": r.hits, "t_sum": r.t_sum, "seconds": seconds, "mrays_per_s": mrays, "accel": kind.name(), "build_quality": a.build_quality.name(), "build_ms": build_ms, "any_hit": a.any_hit, "packet": a.packet.unwrap_or(1), "kernel": kernel, "threads": rayon::current_num_threads() })
             );
         } else {
             let query = match a.packet {
@@ -80,7 +102,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
                 None if a.any_hit => "any hit".into(),
                 None => "closest hit".into(),
             };
-            println!("rays {}  hits {}  t_sum {:.6}  {:.2} Mrays/s ({}, {}, median of {} on {} threads; built in {build_ms:.1} ms at {} quality)", r.count, r.hits, r.t_sum, mrays, kind, query, a.repeats, rayon::current_num_threads(), a.build_quality);
+            println!("rays {}  hits {}  t_sum {:.6}  {:.2} Mrays/s ({}, {}, {kernel} kernel, median of {} on {} threads; built in {build_ms:.1} ms at {} quality)", r.count, r.hits, r.t_sum, mrays, kind, query, a.repeats, rayon::current_num_threads(), a.build_quality);
         }
         Ok(())
     })
