@@ -21,10 +21,15 @@ pub const ROBUST_FAR: f32 = 1.0 + 2.0 * gamma(3);
 /// precomputed: that form (one FMA per slab in Embree) cancels catastrophically near the
 /// origin, where rays leaving a surface need the box test most, and with a zero direction
 /// component it computes `∞ - ∞`. One subtraction more per slab keeps pbrt's error bound.
+/// The far distances' widening by [`ROBUST_FAR`] is folded into their inverse
+/// (`inv_far`): the product `(bound - origin) · (inv · R)` carries the same four roundings
+/// as `((bound - origin) · inv) · R`, so the same bound, for one multiplication less.
 #[derive(Clone, Copy, Debug)]
 pub struct RayBoxes {
     pub origin: [f32; 3],
     pub inv: [f32; 3],
+    /// `inv · ROBUST_FAR`.
+    pub inv_far: [f32; 3],
     /// Row of [`WideNode::bounds`] giving the near (entry) plane of each axis: the min row
     /// when the direction is positive, the max row when it is negative. This sorts the
     /// slab distances once per ray instead of once per box.
@@ -39,7 +44,7 @@ impl RayBoxes {
         let inv = ray.inv_dir().to_array();
         let near = [0, 1, 2].map(|a| if inv[a] < 0.0 { 3 + a } else { a });
         let far = [0, 1, 2].map(|a| if inv[a] < 0.0 { a } else { 3 + a });
-        Self { origin: ray.origin.to_array(), inv, near, far, t_min: ray.t_min }
+        Self { origin: ray.origin.to_array(), inv, inv_far: inv.map(|i| i * ROBUST_FAR), near, far, t_min: ray.t_min }
     }
 }
 
@@ -56,7 +61,7 @@ pub fn boxes_portable<const W: usize>(node: &WideNode<W>, r: &RayBoxes, t_max: f
         let (mut t0, mut t1) = (r.t_min, t_max);
         for a in 0..3 {
             let near = (node.bounds[r.near[a]][lane] - r.origin[a]) * r.inv[a];
-            let far = (node.bounds[r.far[a]][lane] - r.origin[a]) * r.inv[a] * ROBUST_FAR;
+            let far = (node.bounds[r.far[a]][lane] - r.origin[a]) * r.inv_far[a];
             // Written as the SIMD max/min instructions behave: `max(a, b) = a > b ? a : b`.
             t0 = if near > t0 { near } else { t0 };
             t1 = if far < t1 { far } else { t1 };
@@ -100,7 +105,7 @@ pub unsafe fn slabs_avx2(node: &WideNode<8>, r: &RayBoxes, t_max: f32) -> (std::
         // SAFETY: each row holds 8 f32.
         let (lo, hi) = unsafe { (_mm256_loadu_ps(node.bounds[r.near[a]].as_ptr()), _mm256_loadu_ps(node.bounds[r.far[a]].as_ptr())) };
         let near = _mm256_mul_ps(_mm256_sub_ps(lo, o), inv);
-        let far = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(hi, o), inv), _mm256_set1_ps(ROBUST_FAR));
+        let far = _mm256_mul_ps(_mm256_sub_ps(hi, o), _mm256_set1_ps(r.inv_far[a]));
         // `max_ps(a, b)` returns `b` when either is NaN: a NaN slab is ignored.
         t0 = _mm256_max_ps(near, t0);
         t1 = _mm256_min_ps(far, t1);
@@ -121,7 +126,7 @@ pub fn boxes_sse(node: &WideNode<4>, r: &RayBoxes, t_max: f32, tnear: &mut [f32;
             let o = _mm_set1_ps(r.origin[a]);
             let inv = _mm_set1_ps(r.inv[a]);
             let near = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(node.bounds[r.near[a]].as_ptr()), o), inv);
-            let far = _mm_mul_ps(_mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(node.bounds[r.far[a]].as_ptr()), o), inv), _mm_set1_ps(ROBUST_FAR));
+            let far = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(node.bounds[r.far[a]].as_ptr()), o), _mm_set1_ps(r.inv_far[a]));
             t0 = _mm_max_ps(near, t0);
             t1 = _mm_min_ps(far, t1);
         }
