@@ -206,6 +206,18 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, const SIMD: bool, 
                     cur = node.child[first];
                     continue 'walk;
                 }
+                let rest = mask & (mask - 1);
+                if rest & (rest - 1) == 0 {
+                    // Two children, the most frequent case after one: no sort, the same
+                    // order as the keys below give.
+                    let second = rest.trailing_zeros() as usize;
+                    let key = |l: usize| (tnear[l].to_bits() & !(W as u32 - 1)) | l as u32;
+                    let (near, far) = if key(second) < key(first) { (second, first) } else { (first, second) };
+                    stack[sp] = MaybeUninit::new(Entry { node: node.child[far], t: tnear[far] });
+                    sp += 1;
+                    cur = node.child[near];
+                    continue 'walk;
+                }
                 // Sort the hit lanes by entry distance: keys are the distance's bits (in
                 // order for t >= 0) with the lane in the low bits.
                 let lane_bits = W as u32 - 1;
