@@ -146,12 +146,23 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, const SIMD: bool>(
                     continue 'walk;
                 }
                 // Nearest child first, as in single-ray traversal (keys: distance bits
-                // with the lane in the low bits).
+                // with the lane in the low bits); two children without a sort.
                 let lane_bits = W as u32 - 1;
+                let key = |l: usize| (nearest[l].to_bits() & !lane_bits) | l as u32;
+                let rest = any & (any - 1);
+                if rest & (rest - 1) == 0 {
+                    let (first, second) = (any.trailing_zeros() as usize, rest.trailing_zeros() as usize);
+                    let (near, far) = if key(second) < key(first) { (second, first) } else { (first, second) };
+                    stack[sp] = MaybeUninit::new(Entry { node: node.child[far], rays: entered[far], t: nearest[far] });
+                    sp += 1;
+                    cur = node.child[near];
+                    active = entered[near];
+                    continue 'walk;
+                }
                 let mut keys = [0u32; W];
                 let mut k = 0;
                 for l in bits(any) {
-                    let key = (nearest[l].to_bits() & !lane_bits) | l as u32;
+                    let key = key(l);
                     let mut j = k;
                     while j > 0 && keys[j - 1] > key {
                         keys[j] = keys[j - 1];
