@@ -33,15 +33,17 @@ pub enum Kernel {
     Simd,
     /// The same intrinsics with the whole traversal compiled for AVX-512F/VL: 32 vector
     /// registers instead of 16 and mask registers for the compares. Same IEEE operations
-    /// in the same order, so the same answers.
+    /// in the same order, so the same answers. Opt-in: see [`Kernel::detect`].
     Avx512,
 }
 
 impl Kernel {
-    /// The fastest kernel this CPU runs for width `w` (runtime detection: the binary stays
-    /// portable, no `target-cpu` needed).
+    /// The default kernel for width `w` on this CPU (runtime detection: the binary stays
+    /// portable, no `target-cpu` needed): [`Kernel::Simd`] where it runs. Not
+    /// [`Kernel::Avx512`]: measured no faster (docs/performance.md), it is there to be
+    /// chosen (`raylab trace --kernel avx512`) and compared.
     pub fn detect(w: usize) -> Kernel {
-        Kernel::Avx512.available(w)
+        Kernel::Simd.available(w)
     }
 
     /// `self` if this CPU runs it for width `w`, else the next best that it runs.
