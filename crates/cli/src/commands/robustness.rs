@@ -19,6 +19,10 @@ pub struct RobustnessArgs {
     /// Structures to measure: a comma-separated list, or "all"
     #[arg(long, default_value = "all")]
     pub accels: String,
+    /// Primitive kinds to measure: a comma-separated list of triangles, spheres, curves
+    /// and patches, or "all"
+    #[arg(long, default_value = "all")]
+    pub prims: String,
     /// Print JSON instead of the table
     #[arg(long)]
     pub json: bool,
@@ -33,13 +37,32 @@ pub fn run(a: &RobustnessArgs) -> Result<()> {
         None => SCALES.to_vec(),
         Some(list) => parse_scales(list)?,
     };
-    let r = measure(&kinds, &scales, a.rays);
+    let prims = parse_prims(&a.prims)?;
+    let r = measure(&kinds, &prims, &scales, a.rays);
     if a.json {
         println!("{}", serde_json::to_string_pretty(&r)?);
     } else {
         print!("{}", table(&r));
     }
     Ok(())
+}
+
+/// `--prims`: primitive kinds by name, each once, or "all".
+fn parse_prims(list: &str) -> Result<Vec<PrimKind>> {
+    if list.trim() == "all" {
+        return Ok(PrimKind::ALL.to_vec());
+    }
+    let mut prims = Vec::new();
+    for name in list.split(',').map(str::trim) {
+        let Some(p) = PrimKind::from_name(name) else {
+            bail!("--prims: unknown primitive kind {name:?} (expected triangles, spheres, curves, patches or all)");
+        };
+        if prims.contains(&p) {
+            bail!("--prims: {name} is given twice");
+        }
+        prims.push(p);
+    }
+    Ok(prims)
 }
 
 /// `--scales`: finite positive numbers, each once.
@@ -101,7 +124,7 @@ mod tests {
 
     #[test]
     fn table_has_a_row_per_structure_and_kind_and_a_column_per_scale() {
-        let r = measure(&[AccelKind::Bvh], &SCALES, 20);
+        let r = measure(&[AccelKind::Bvh], &PrimKind::ALL, &SCALES, 20);
         let t = table(&r);
         let lines: Vec<&str> = t.lines().collect();
         assert_eq!(lines[0], "leaks / self-intersections, 20 leak rays and 20 spawned rays per cell");
@@ -110,8 +133,14 @@ mod tests {
         assert!(lines[7].starts_with("| bvh | patches | - / 0 |"), "{}", lines[7]);
         assert_eq!(lines.len(), 4 + 4 + 2);
         // `--scales` chooses the columns, in the order given.
-        let r = measure(&[AccelKind::Bvh], &parse_scales("1e12, 1e-10").unwrap(), 20);
+        let r = measure(&[AccelKind::Bvh], &PrimKind::ALL, &parse_scales("1e12, 1e-10").unwrap(), 20);
         assert_eq!(table(&r).lines().nth(2), Some("| structure | primitives | 1e12 | 1e-10 |"));
+        // `--prims` chooses the rows, in the order given.
+        let r = measure(&[AccelKind::Bvh], &parse_prims("patches, spheres").unwrap(), &[1.0], 20);
+        assert_eq!(table(&r).lines().skip(4).take(2).collect::<Vec<_>>(), ["| bvh | patches | - / 0 |", "| bvh | spheres | 0 / 0 |"]);
+        assert_eq!(parse_prims("all").unwrap(), PrimKind::ALL);
+        assert_eq!(parse_prims("cones").unwrap_err().to_string(), "--prims: unknown primitive kind \"cones\" (expected triangles, spheres, curves, patches or all)");
+        assert_eq!(parse_prims("patches,patches").unwrap_err().to_string(), "--prims: patches is given twice");
         assert_eq!(parse_scales("1,0").unwrap_err().to_string(), "--scales: expected positive finite numbers, found 0");
         assert_eq!(parse_scales("1,1e0").unwrap_err().to_string(), "--scales: 1e0 is given twice");
         assert_eq!(parse_scales("1,x").unwrap_err().to_string(), "--scales: invalid float literal");
