@@ -721,3 +721,20 @@ fn one_sided_models_reflect_nothing_exactly_at_the_horizon() {
         assert!(b.sample(flat, 0.5, Vec2::new(0.3, 0.6)).is_none(), "{b:?}: sampled from the horizon");
     }
 }
+
+#[test]
+fn index_matched_dielectric_is_invisible() {
+    // n = 1 on both sides: the Fresnel equations give r_s = r_p = 0 below grazing, so all
+    // the light goes straight through, for every u_lobe down to 0, with weight 1 (η = 1).
+    // At these cosines cos θt = √(1 − (1 − cos²θ)) is exact in f32, so F is exactly 0
+    // (elsewhere rounding leaves F ~ 1e-15, and u_lobe = 0 may reflect, rightly).
+    for cos in [1.0f32, 0.75, 0.5, 0.25, -0.5, -0.75] {
+        let wo = dir(cos, 0.8);
+        assert_eq!(fresnel_dielectric(cos, 1.0), 0.0, "cos {cos}");
+        for u_lobe in [0.0f32, 0.5, 1.0 - f32::EPSILON / 2.0] {
+            let s = Bsdf::Dielectric { ior: 1.0 }.sample(wo, u_lobe, Vec2::ZERO).expect("transmission");
+            assert!((s.wi + wo).length() < 1e-6 && s.pdf == 1.0, "cos {cos} u_lobe {u_lobe}: {s:?}");
+            assert!(close(s.f.x * s.wi.z.abs() / s.pdf, 1.0, 1e-6), "cos {cos}: {s:?}");
+        }
+    }
+}
