@@ -34,7 +34,7 @@ crates=("$@")
 files=()
 for f in ${MUTANTS_FILES:-}; do files+=(--file "$f"); done
 [ -z "${MUTANTS_ITERATE:-}" ] || files+=(--iterate)
-for a in ${MUTANTS_TEST_ARGS:-}; do files+=(--cargo-arg "$a"); done
+for a in ${MUTANTS_TEST_ARGS:-}; do files+=("--cargo-arg=$a"); done
 
 count() { [ -f "$1" ] && wc -l <"$1" | tr -d ' ' || echo 0; }
 
