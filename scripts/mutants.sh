@@ -14,7 +14,14 @@
 # these files (space-separated paths or globs). MUTANTS_JOBS: parallel builds (default 1).
 # MUTANTS_OUT: results folder (default target/mutants). MUTANTS_ITERATE=1: re-test only
 # the mutants not caught by the previous run into the same folder (after adding tests); the
-# summary then counts the re-tested mutants only.
+# summary then counts the re-tested mutants only. MUTANTS_TEST_ARGS: which of the crate's
+# test targets to build and run, space-separated cargo arguments, each passed to every cargo
+# invocation as one `--cargo-arg` (`--cargo-test-arg` would reach `cargo test` but not the
+# `cargo test --no-run` build before it, which would still build every target). E.g.
+# MUTANTS_TEST_ARGS='--lib' builds and runs only the crate's unit tests: for `raylab-render` a
+# mutant then costs one build of the library instead of one per integration test binary. Use
+# it for a fast first pass, then re-test the missed mutants with MUTANTS_ITERATE=1 and no
+# test args, so that the rates reported are against the crate's full tests.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -27,6 +34,7 @@ crates=("$@")
 files=()
 for f in ${MUTANTS_FILES:-}; do files+=(--file "$f"); done
 [ -z "${MUTANTS_ITERATE:-}" ] || files+=(--iterate)
+for a in ${MUTANTS_TEST_ARGS:-}; do files+=("--cargo-arg=$a"); done
 
 count() { [ -f "$1" ] && wc -l <"$1" | tr -d ' ' || echo 0; }
 

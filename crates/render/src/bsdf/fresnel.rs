@@ -145,6 +145,18 @@ mod tests {
     }
 
     #[test]
+    fn complex_sqrt_is_the_principal_root() {
+        // Squares worked by hand: (1 ∓ i)² = ∓2i, (2 + i)² = 3 + 4i, (1 − 2i)² = −3 − 4i, and
+        // on the negative real axis (imaginary part +0) the root on the positive imaginary
+        // axis, as C99's `csqrt(−4 + 0i) = 2i`. The conductor equations only take roots of
+        // numbers in the upper half plane, so the lower half plane is checked here directly.
+        for (z, root) in [((0.0, -2.0), (1.0, -1.0)), ((0.0, 2.0), (1.0, 1.0)), ((3.0, 4.0), (2.0, 1.0)), ((-3.0, -4.0), (1.0, -2.0)), ((-4.0, 0.0), (0.0, 2.0)), ((9.0, 0.0), (3.0, 0.0))] {
+            let r = Complex(z.0, z.1).sqrt();
+            assert!((r.0 - root.0).abs() < 1e-6 && (r.1 - root.1).abs() < 1e-6, "√{z:?} = {r:?}, not {root:?}");
+        }
+    }
+
+    #[test]
     fn snell_law_holds() {
         let n = Vec3::Z;
         let wo = Vec3::new(0.6, 0.0, 0.8);

@@ -682,3 +682,59 @@ fn sample_histogram_matches_pdf_for_every_model() {
         }
     }
 }
+
+#[test]
+fn cook_torrance_horizon_cut_is_at_one_millionth() {
+    // `cook_torrance.rs` gives light to directions at least 1e-6 above the horizon (its
+    // `MIN_COS`, "at least": see `half_vector`) and none below: at exactly 1e-6 `f`, `pdf`
+    // and `sample` are alive, 1 % lower they are zero. Either direction may be the grazing one.
+    let at = Vec3::new((1.0f32 - 1e-12).sqrt(), 0.0, 1e-6);
+    let below = Vec3::new(1.0, 0.0, 0.99e-6);
+    let other = dir(0.6, 2.0);
+    for d in DISTRIBUTIONS {
+        for g in GEOMETRIES {
+            let b = cook_torrance(d, g, 0.3);
+            for (wo, wi) in [(at, other), (other, at)] {
+                assert!(b.eval(wo, wi).min_element() > 0.0 && b.pdf(wo, wi) > 0.0, "{d} {g}: {wo} {wi}");
+            }
+            for (wo, wi) in [(below, other), (other, below)] {
+                assert_eq!((b.eval(wo, wi), b.pdf(wo, wi)), (Rgb::ZERO, 0.0), "{d} {g}: {wo} {wi}");
+            }
+            // From a grazing wo the diffuse lobe (u_lobe = 0.99 ≥ its specular share) still samples.
+            assert!(b.sample(at, 0.99, Vec2::new(0.3, 0.6)).is_some(), "{d} {g}");
+            assert!(b.sample(below, 0.99, Vec2::new(0.3, 0.6)).is_none(), "{d} {g}");
+        }
+    }
+}
+
+#[test]
+fn one_sided_models_reflect_nothing_exactly_at_the_horizon() {
+    // One-sided means `wo.z > 0` and `wi.z > 0` (module doc): a direction in the tangent
+    // plane, z = 0, gets neither `f` nor density, from either end.
+    let flat = Vec3::new(0.6, 0.8, 0.0);
+    let up = dir(0.7, 1.0);
+    for b in [Bsdf::Lambert { albedo: Rgb::new(0.8, 0.5, 0.2) }, Bsdf::Phong { kd: Rgb::new(0.3, 0.2, 0.1), ks: Rgb::new(0.5, 0.6, 0.7), exponent: 3.0 }] {
+        for (wo, wi) in [(flat, up), (up, flat), (flat, flat)] {
+            assert_eq!(b.eval(wo, wi), Rgb::ZERO, "{b:?}: f({wo}, {wi})");
+        }
+        assert_eq!(b.pdf(flat, up), 0.0, "{b:?}: pdf from the horizon");
+        assert!(b.sample(flat, 0.5, Vec2::new(0.3, 0.6)).is_none(), "{b:?}: sampled from the horizon");
+    }
+}
+
+#[test]
+fn index_matched_dielectric_is_invisible() {
+    // n = 1 on both sides: the Fresnel equations give r_s = r_p = 0 below grazing, so all
+    // the light goes straight through, for every u_lobe down to 0, with weight 1 (η = 1).
+    // At these cosines cos θt = √(1 − (1 − cos²θ)) is exact in f32, so F is exactly 0
+    // (elsewhere rounding leaves F ~ 1e-15, and u_lobe = 0 may reflect, rightly).
+    for cos in [1.0f32, 0.75, 0.5, 0.25, -0.5, -0.75] {
+        let wo = dir(cos, 0.8);
+        assert_eq!(fresnel_dielectric(cos, 1.0), 0.0, "cos {cos}");
+        for u_lobe in [0.0f32, 0.5, 1.0 - f32::EPSILON / 2.0] {
+            let s = Bsdf::Dielectric { ior: 1.0 }.sample(wo, u_lobe, Vec2::ZERO).expect("transmission");
+            assert!((s.wi + wo).length() < 1e-6 && s.pdf == 1.0, "cos {cos} u_lobe {u_lobe}: {s:?}");
+            assert!(close(s.f.x * s.wi.z.abs() / s.pdf, 1.0, 1e-6), "cos {cos}: {s:?}");
+        }
+    }
+}
