@@ -135,7 +135,7 @@ pub fn boxes_sse(node: &WideNode<4>, r: &RayBoxes, t_max: f32, tnear: &mut [f32;
     }
 }
 
-/// Lanes of `b` that may be hit: every lane except those whose three single-precision
+/// Lanes of `b` that may be hit (the portable kernel's filter): every lane except those whose three single-precision
 /// edge functions are all non-zero with mixed signs, which [`ShearedRay::triangle`] rejects
 /// too (it recomputes in double precision only when one of them is exactly zero). Lanes
 /// that are not triangles ([`TriBlock::OTHER`]) are always candidates; empty lanes never.
@@ -166,43 +166,6 @@ pub fn triangle_candidates(b: &TriBlock, s: &ShearedRay) -> u32 {
         mask |= u32::from(keep) << l;
     }
     mask
-}
-
-/// [`triangle_candidates`] with SSE2 (part of every x86-64 CPU): the same operations on
-/// four lanes at once, so the same mask.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-pub fn triangle_candidates_sse(b: &TriBlock, s: &ShearedRay) -> u32 {
-    use std::arch::x86_64::*;
-    let (kx, ky, kz) = (s.kx, s.ky, s.kz);
-    // SAFETY: SSE2 is in the x86-64 baseline; every row holds 4 f32.
-    let rejected = unsafe {
-        let (ox, oy, oz) = (_mm_set1_ps(s.origin[kx]), _mm_set1_ps(s.origin[ky]), _mm_set1_ps(s.origin[kz]));
-        let (sx, sy) = (_mm_set1_ps(s.sx), _mm_set1_ps(s.sy));
-        let project = |v: usize| {
-            let az = _mm_sub_ps(_mm_loadu_ps(b.p[v][kz].as_ptr()), oz);
-            let x = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(b.p[v][kx].as_ptr()), ox), _mm_mul_ps(sx, az));
-            let y = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(b.p[v][ky].as_ptr()), oy), _mm_mul_ps(sy, az));
-            (x, y)
-        };
-        let ((ax, ay), (bx, by), (cx, cy)) = (project(0), project(1), project(2));
-        let u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
-        let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
-        let w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
-        let zero = _mm_setzero_ps();
-        let neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)), _mm_cmplt_ps(w, zero));
-        let pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)), _mm_cmpgt_ps(w, zero));
-        // `cmpneq` is true for NaN, as `!=` is.
-        let nonzero = _mm_and_ps(_mm_and_ps(_mm_cmpneq_ps(u, zero), _mm_cmpneq_ps(v, zero)), _mm_cmpneq_ps(w, zero));
-        _mm_movemask_ps(_mm_and_ps(_mm_and_ps(neg, pos), nonzero)) as u32
-    };
-    let mut keep = 0u32;
-    for l in 0..4 {
-        let prim = b.prim[l];
-        let k = prim != EMPTY && (prim & TriBlock::OTHER != 0 || rejected & (1 << l) == 0);
-        keep |= u32::from(k) << l;
-    }
-    keep
 }
 
 /// The watertight kernel's answers for the four lanes of a block ([`triangles_sse`]).
@@ -376,35 +339,6 @@ mod tests {
             }
         }
         assert!(kept > 100, "too few hits to test the filter: {kept}");
-    }
-
-    /// The SSE filter gives the portable filter's mask, also on degenerate triangles
-    /// (zero area, vertices at the origin: zero edge functions) and huge coordinates
-    /// (infinite or NaN edge functions).
-    #[cfg(target_arch = "x86_64")]
-    #[test]
-    fn sse_triangle_filter_matches_portable() {
-        let mut rng = raylab_core::Pcg32::new(6, 1);
-        let mut r = |scale: f32| Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, rng.next_f32() - 0.5) * scale;
-        for k in 0..20000 {
-            let mut b = TriBlock::EMPTY_BLOCK;
-            for l in 0..(k % 4 + 1) {
-                let scale = [1.0, 1e-30, 1e30, 3e38][(k / 4) % 4];
-                let v = match (k + l) % 5 {
-                    0 => [Vec3::ZERO; 3],
-                    1 => { let p = r(scale); [p, p, r(scale)] }
-                    _ => [r(scale), r(scale), r(scale)],
-                };
-                b.set_triangle(l, l as u32, v);
-            }
-            if k % 7 == 0 {
-                b.prim[0] = 3 | TriBlock::OTHER;
-            }
-            let o = if k % 3 == 0 { Vec3::ZERO } else { r(2.0) };
-            let ray = Ray::new(o, (r(1.0) + Vec3::splat(1e-3)).normalize());
-            let s = ShearedRay::new(&ray);
-            assert_eq!(triangle_candidates_sse(&b, &s), triangle_candidates(&b, &s), "block {k}");
-        }
     }
 
     /// The four-wide kernel decides each lane exactly as the scalar kernel does (same `t`
