@@ -6,7 +6,7 @@ use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Kernel, P
 use raylab_core::{Aabb, Pcg32, Ray, Vec3};
 use raylab_testkit::{self as kit, Soup};
 
-const WIDE: [AccelKind; 3] = [AccelKind::Bvh8, AccelKind::Bvh4, AccelKind::Bvh8Sbvh];
+const WIDE: [AccelKind; 4] = [AccelKind::Bvh8, AccelKind::Bvh4, AccelKind::Bvh8Sbvh, AccelKind::Bvh8Q];
 
 /// The SIMD kernels each test against the portable one (on a CPU without AVX-512,
 /// `Avx512` falls back to `Simd` and the pair is tested twice).
@@ -114,7 +114,7 @@ fn watertight_from_inside_the_cube() {
 #[test]
 fn oversized_binary_leaf_is_split() {
     use raylab_accel::bvh::{Bvh, BvhNode};
-    use raylab_accel::WideBvh;
+    use raylab_accel::{QuantNode, WideBvh};
     let mut rng = Pcg32::new(24, 1);
     let unit = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
     let soup = kit::random_triangles(&mut rng, 300, &unit, 0.2);
@@ -122,11 +122,15 @@ fn oversized_binary_leaf_is_split() {
     let oracle = AnyAccel::build(AccelKind::None, &soup, &BuildOptions::default());
     for kernel in [Kernel::Avx512, Kernel::Simd, Kernel::Portable] {
         let wide = WideBvh::<8>::from_binary(&bin, &soup, "bvh8").with_kernel(kernel);
+        let quant = WideBvh::<8, QuantNode>::from_binary(&bin, &soup, "bvh8q").with_kernel(kernel);
         wide.validate(&soup).unwrap();
-        assert!(!wide.nodes.is_empty(), "the leaf was not split");
+        quant.validate(&soup).unwrap();
+        assert!(!wide.nodes.is_empty() && !quant.nodes.is_empty(), "the leaf was not split");
         let mut c = Counters::default();
         for ray in kit::random_rays(&mut rng, 500, &unit, &unit) {
-            assert_eq!(wide.intersect(&soup, &ray, &mut c).map(|h| h.t), oracle.intersect(&soup, &ray, &mut c).map(|h| h.t));
+            let want = oracle.intersect(&soup, &ray, &mut c).map(|h| h.t);
+            assert_eq!(wide.intersect(&soup, &ray, &mut c).map(|h| h.t), want);
+            assert_eq!(quant.intersect(&soup, &ray, &mut c).map(|h| h.t), want);
         }
     }
 }
@@ -241,7 +245,7 @@ fn build_quality_picks_the_builder() {
     for (quality, same_as) in [(BuildQuality::Low, AccelKind::Lbvh), (BuildQuality::Medium, AccelKind::Bvh), (BuildQuality::High, AccelKind::Sbvh)] {
         let opts = BuildOptions { quality, ..Default::default() };
         assert_eq!(stats(AccelKind::Bvh, &opts), stats(same_as, &BuildOptions::default()), "{quality}: bvh is {same_as}'s tree");
-        for kind in [AccelKind::Bvh, AccelKind::Bvh4, AccelKind::Bvh8] {
+        for kind in [AccelKind::Bvh, AccelKind::Bvh4, AccelKind::Bvh8, AccelKind::Bvh8Q] {
             let accel = AnyAccel::build(kind, &soup, &opts);
             accel.validate(&soup).unwrap_or_else(|e| panic!("{quality}/{kind}: {e}"));
             assert_eq!(accel.stats().name, kind.name());
@@ -252,4 +256,30 @@ fn build_quality_picks_the_builder() {
         }
     }
     assert_eq!("ultra".parse::<BuildQuality>().unwrap_err(), "unknown build quality `ultra` (valid: low, medium, high)");
+}
+
+/// The quantised layout is `bvh8`'s tree with boxes rounded outward: the same answers to
+/// the bit (hits are the least `(t, primitive)`, whatever the order), at least as many
+/// node visits, the same triangle blocks, and nodes of 96 bytes instead of 224.
+#[test]
+fn quantised_nodes_answer_as_bvh8() {
+    let soup = kit::read_obj_triangles(&kit::shared_scenes().join("bunny_4968.obj"));
+    let b = soup.bounds();
+    let mut rng = Pcg32::new(27, 1);
+    let rays = kit::random_rays(&mut rng, 3000, &Aabb::new(b.min - b.extent(), b.max + b.extent()), &b);
+    let f32_boxes = AnyAccel::build(AccelKind::Bvh8, &soup, &BuildOptions::default());
+    let quant = AnyAccel::build(AccelKind::Bvh8Q, &soup, &BuildOptions::default());
+    let (mut cf, mut cq) = (Counters::default(), Counters::default());
+    for (k, ray) in rays.iter().enumerate() {
+        assert_eq!(quant.intersect(&soup, ray, &mut cq), f32_boxes.intersect(&soup, ray, &mut cf), "ray {k}");
+        assert_eq!(quant.occluded(&soup, ray, &mut cq), f32_boxes.occluded(&soup, ray, &mut cf), "ray {k}: any hit");
+    }
+    assert!(cq.nodes_visited >= cf.nodes_visited, "looser boxes cannot visit fewer nodes: {} < {}", cq.nodes_visited, cf.nodes_visited);
+    // Looser by a few percent at most: 8 bits per bound leave boxes within 1/255 of their node.
+    assert!((cq.nodes_visited as f64) < 1.1 * cf.nodes_visited as f64, "{} vs {} nodes", cq.nodes_visited, cf.nodes_visited);
+    let (sf, sq) = (f32_boxes.stats(), quant.stats());
+    assert_eq!((sq.interior_nodes, sq.leaves, sq.references), (sf.interior_nodes, sf.leaves, sf.references));
+    let blocks = sf.memory_bytes - 224 * sf.interior_nodes;
+    assert_eq!(sq.memory_bytes, blocks + 96 * sq.interior_nodes, "96-byte nodes, the same blocks");
+    assert!(sq.notes.iter().any(|(k, v)| k == "boxes" && v == "quantised"));
 }

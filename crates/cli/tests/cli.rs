@@ -160,7 +160,7 @@ fn bench_agrees_with_the_oracle_and_trace_reproduces_it() {
     let json: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("b.json")).unwrap()).unwrap();
     let results = json["results"].as_array().unwrap();
     let accels: Vec<&str> = results.iter().map(|r| r["accel"].as_str().unwrap()).collect();
-    assert_eq!(accels, ["none", "bvh", "bvh-median", "bvh-midpoint", "aabb", "grid", "lbvh", "lbvh-ploc", "kdtree", "sphere-bvh", "sbvh", "bvh8", "bvh4", "bvh8-sbvh"]);
+    assert_eq!(accels, ["none", "bvh", "bvh-median", "bvh-midpoint", "aabb", "grid", "lbvh", "lbvh-ploc", "kdtree", "sphere-bvh", "sbvh", "bvh8", "bvh4", "bvh8-sbvh", "bvh8q"]);
     let oracle = &results[0]["rays"]["primary"];
     for r in results {
         assert_eq!(r["rays"]["primary"]["hits"], oracle["hits"], "{}", r["accel"]);

@@ -20,7 +20,7 @@ fn render_help_lists_every_structure_and_points_nowhere_else() {
     let o = raylab(&["render", "--help"], Path::new("."));
     let help = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success());
-    let names = "none, bvh, bvh-median, bvh-midpoint, aabb, grid, lbvh, lbvh-ploc, kdtree, sphere-bvh, sbvh, bvh8, bvh4, bvh8-sbvh";
+    let names = "none, bvh, bvh-median, bvh-midpoint, aabb, grid, lbvh, lbvh-ploc, kdtree, sphere-bvh, sbvh, bvh8, bvh4, bvh8-sbvh, bvh8q";
     assert_eq!(names, raylab_accel::AccelKind::names());
     assert!(help.contains(names), "{help}");
     assert!(!help.contains("inspect --help"), "{help}");

@@ -40,6 +40,6 @@ impl<P: Primitives + Sync + ?Sized> Peer for RaylabPeer<'_, P> {
     }
     /// The wide BVHs trace packets together; the other structures one ray at a time.
     fn has_packets(&self) -> bool {
-        matches!(self.kind, AccelKind::Bvh8 | AccelKind::Bvh4)
+        matches!(self.kind, AccelKind::Bvh8 | AccelKind::Bvh4 | AccelKind::Bvh8Sbvh | AccelKind::Bvh8Q)
     }
 }

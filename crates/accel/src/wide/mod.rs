@@ -3,7 +3,8 @@
 //! form, tested at once with SIMD; leaves hold blocks of four triangles copied from the
 //! mesh (Embree's `Triangle4`), tested without index indirection.
 //!
-//! - `node.rs`: the memory layout and its byte budget;
+//! - `node.rs`: the memory layout and its byte budget, and the [`Layout`] of a node's boxes;
+//! - `quant.rs`: the quantised 8-wide node (`bvh8q`, 96 bytes instead of 224);
 //! - `collapse.rs`: binary → wide, Embree's largest-area-first opening;
 //! - `kernels.rs`: box and triangle kernels, SIMD and portable with identical answers;
 //! - `traverse.rs`: closest and any hit, counting or not;
@@ -13,13 +14,14 @@ mod collapse;
 pub mod kernels;
 pub mod node;
 mod packet;
+pub mod quant;
 mod traverse;
 
 use raylab_core::{Aabb, Ray};
 
 use crate::bvh::Bvh;
 use crate::{Accel, AccelStats, Counters, Hit, Primitives, ValidationError};
-use node::{is_leaf, leaf_blocks, ChildRef, TriBlock, WideNode, EMPTY};
+use node::{is_leaf, leaf_blocks, ChildRef, Layout, TriBlock, WideNode, EMPTY};
 
 pub use collapse::LEAF_PRIMS;
 pub use packet::PACKET;
@@ -63,14 +65,14 @@ impl Kernel {
     }
 }
 
-/// A `W`-wide BVH.
+/// A `W`-wide BVH whose nodes store their boxes as layout `N` (f32 by default).
 ///
 /// Invariants: `root` is [`EMPTY`] exactly when there are no primitives; every interior
 /// reference indexes `nodes`, every leaf reference a range of `blocks`; every primitive is
 /// in some block lane.
 #[derive(Debug)]
-pub struct WideBvh<const W: usize> {
-    pub nodes: Vec<WideNode<W>>,
+pub struct WideBvh<const W: usize, N: Layout<W> = WideNode<W>> {
+    pub nodes: Vec<N>,
     pub blocks: Vec<TriBlock>,
     pub root: ChildRef,
     root_bounds: Aabb,
@@ -81,12 +83,15 @@ pub struct WideBvh<const W: usize> {
     kernel: Kernel,
 }
 
-impl<const W: usize> WideBvh<W> {
+impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
     /// Converts a binary BVH built over `prims`.
     pub fn from_binary<P: Primitives + ?Sized>(bvh: &Bvh, prims: &P, name: &'static str) -> Self {
         const { assert!(W == 4 || W == 8, "wide BVHs are 4 or 8 wide") };
         let c = collapse::collapse::<P, W>(bvh, prims);
-        Self { nodes: c.nodes, blocks: c.blocks, root: c.root, root_bounds: c.root_bounds, name, build_ms: 0.0, primitives: prims.len(), spatial_splits: bvh.spatial_splits, kernel: Kernel::detect(W) }
+        let nodes: Vec<N> = encode(&c.nodes, c.root);
+        // The root's decoded boxes may round past the scene's bounds: the root box holds them.
+        let root_bounds = if c.root == EMPTY || is_leaf(c.root) { c.root_bounds } else { nodes[c.root as usize].with_decoded(|n| (0..W).filter(|&l| n.child[l] != EMPTY).fold(c.root_bounds, |b, l| b.union(n.child_bounds(l)))) };
+        Self { nodes, blocks: c.blocks, root: c.root, root_bounds, name, build_ms: 0.0, primitives: prims.len(), spatial_splits: bvh.spatial_splits, kernel: Kernel::detect(W) }
     }
 
     /// Forces a kernel (tests compare them). Asking for one this CPU lacks gives the next
@@ -125,13 +130,13 @@ impl<const W: usize> WideBvh<W> {
         #[cfg(target_arch = "x86_64")]
         match self.kernel {
             // SAFETY: `Kernel::Avx512` is only chosen after detecting its features.
-            Kernel::Avx512 => return unsafe { packet_avx512::<P, W>(self, prims, rays, out) },
+            Kernel::Avx512 => return unsafe { packet_avx512::<P, W, N>(self, prims, rays, out) },
             // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
-            Kernel::Simd if W == 8 => return unsafe { packet_avx2::<P, W>(self, prims, rays, out) },
-            Kernel::Simd => return packet::closest::<P, W, true>(self, prims, rays, out),
+            Kernel::Simd if W == 8 => return unsafe { packet_avx2::<P, W, N>(self, prims, rays, out) },
+            Kernel::Simd => return packet::closest::<P, W, N, true>(self, prims, rays, out),
             Kernel::Portable => {}
         }
-        packet::closest::<P, W, false>(self, prims, rays, out)
+        packet::closest::<P, W, N, false>(self, prims, rays, out)
     }
 
     #[inline]
@@ -139,13 +144,13 @@ impl<const W: usize> WideBvh<W> {
         #[cfg(target_arch = "x86_64")]
         match self.kernel {
             // SAFETY: `Kernel::Avx512` is only chosen after detecting its features.
-            Kernel::Avx512 => return unsafe { closest_avx512::<P, W, COUNT>(self, prims, ray, c) },
+            Kernel::Avx512 => return unsafe { closest_avx512::<P, W, N, COUNT>(self, prims, ray, c) },
             // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
-            Kernel::Simd if W == 8 => return unsafe { closest_avx2::<P, W, COUNT>(self, prims, ray, c) },
-            Kernel::Simd => return traverse::closest::<P, W, true, COUNT>(self, prims, ray, c),
+            Kernel::Simd if W == 8 => return unsafe { closest_avx2::<P, W, N, COUNT>(self, prims, ray, c) },
+            Kernel::Simd => return traverse::closest::<P, W, N, true, COUNT>(self, prims, ray, c),
             Kernel::Portable => {}
         }
-        traverse::closest::<P, W, false, COUNT>(self, prims, ray, c)
+        traverse::closest::<P, W, N, false, COUNT>(self, prims, ray, c)
     }
 
     #[inline]
@@ -153,13 +158,13 @@ impl<const W: usize> WideBvh<W> {
         #[cfg(target_arch = "x86_64")]
         match self.kernel {
             // SAFETY: `Kernel::Avx512` is only chosen after detecting its features.
-            Kernel::Avx512 => return unsafe { any_avx512::<P, W, COUNT>(self, prims, ray, c) },
+            Kernel::Avx512 => return unsafe { any_avx512::<P, W, N, COUNT>(self, prims, ray, c) },
             // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
-            Kernel::Simd if W == 8 => return unsafe { any_avx2::<P, W, COUNT>(self, prims, ray, c) },
-            Kernel::Simd => return traverse::any::<P, W, true, COUNT>(self, prims, ray, c),
+            Kernel::Simd if W == 8 => return unsafe { any_avx2::<P, W, N, COUNT>(self, prims, ray, c) },
+            Kernel::Simd => return traverse::any::<P, W, N, true, COUNT>(self, prims, ray, c),
             Kernel::Portable => {}
         }
-        traverse::any::<P, W, false, COUNT>(self, prims, ray, c)
+        traverse::any::<P, W, N, false, COUNT>(self, prims, ray, c)
     }
 
     /// Calls `f(reference, bounds, depth)` for every child reference, depth first.
@@ -171,12 +176,13 @@ impl<const W: usize> WideBvh<W> {
         while let Some((r, b, depth)) = stack.pop() {
             f(r, &b, depth);
             if !is_leaf(r) {
-                let n = &self.nodes[r as usize];
-                for lane in 0..W {
-                    if n.child[lane] != EMPTY {
-                        stack.push((n.child[lane], n.child_bounds(lane), depth + 1));
+                self.nodes[r as usize].with_decoded(|n| {
+                    for lane in 0..W {
+                        if n.child[lane] != EMPTY {
+                            stack.push((n.child[lane], n.child_bounds(lane), depth + 1));
+                        }
                     }
-                }
+                });
             }
         }
     }
@@ -187,47 +193,76 @@ impl<const W: usize> WideBvh<W> {
     }
 }
 
+/// Lays out `nodes` as `N`, children before parents, each interior lane's box widened to
+/// the union of its child's decoded boxes: a layout that rounds boxes outward (quantised)
+/// then still nests every box in its parent's, which validation checks. For f32 boxes the
+/// union is the lane's own box, so nothing changes.
+fn encode<const W: usize, N: Layout<W>>(nodes: &[WideNode<W>], root: ChildRef) -> Vec<N> {
+    let mut preorder = Vec::with_capacity(nodes.len());
+    let mut stack = vec![root];
+    while let Some(r) = stack.pop() {
+        if r != EMPTY && !is_leaf(r) {
+            preorder.push(r as usize);
+            stack.extend(nodes[r as usize].child);
+        }
+    }
+    let mut out: Vec<Option<N>> = vec![None; nodes.len()];
+    for &i in preorder.iter().rev() {
+        let mut n = nodes[i];
+        for lane in 0..W {
+            let r = n.child[lane];
+            if r != EMPTY && !is_leaf(r) {
+                let widened = out[r as usize].expect("children come first").with_decoded(|c| (0..W).filter(|&l| c.child[l] != EMPTY).fold(n.child_bounds(lane), |b, l| b.union(c.child_bounds(l))));
+                n.set(lane, &widened, r);
+            }
+        }
+        out[i] = Some(N::encode(&n));
+    }
+    // Nodes no traversal reaches (validation reports them) keep their own boxes.
+    out.into_iter().zip(nodes).map(|(e, n)| e.unwrap_or_else(|| N::encode(n))).collect()
+}
+
 /// The AVX2 instantiations: the whole traversal is compiled with AVX2 so that the box
 /// kernel inlines into it.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn closest_avx2<P: Primitives + ?Sized, const W: usize, const COUNT: bool>(bvh: &WideBvh<W>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
-    traverse::closest::<P, W, true, COUNT>(bvh, prims, ray, c)
+unsafe fn closest_avx2<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
+    traverse::closest::<P, W, N, true, COUNT>(bvh, prims, ray, c)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn packet_avx2<P: Primitives + ?Sized, const W: usize>(bvh: &WideBvh<W>, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
-    packet::closest::<P, W, true>(bvh, prims, rays, out)
+unsafe fn packet_avx2<P: Primitives + ?Sized, const W: usize, N: Layout<W>>(bvh: &WideBvh<W, N>, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
+    packet::closest::<P, W, N, true>(bvh, prims, rays, out)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn any_avx2<P: Primitives + ?Sized, const W: usize, const COUNT: bool>(bvh: &WideBvh<W>, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
-    traverse::any::<P, W, true, COUNT>(bvh, prims, ray, c)
+unsafe fn any_avx2<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
+    traverse::any::<P, W, N, true, COUNT>(bvh, prims, ray, c)
 }
 
 /// The AVX-512 instantiations: the same code as the AVX2 ones (the AVX2 and SSE2
 /// intrinsics inline into them), given 32 vector registers, mask registers and BMI.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,avx512f,avx512vl,bmi1,bmi2")]
-unsafe fn closest_avx512<P: Primitives + ?Sized, const W: usize, const COUNT: bool>(bvh: &WideBvh<W>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
-    traverse::closest::<P, W, true, COUNT>(bvh, prims, ray, c)
+unsafe fn closest_avx512<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
+    traverse::closest::<P, W, N, true, COUNT>(bvh, prims, ray, c)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,avx512f,avx512vl,bmi1,bmi2")]
-unsafe fn packet_avx512<P: Primitives + ?Sized, const W: usize>(bvh: &WideBvh<W>, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
-    packet::closest::<P, W, true>(bvh, prims, rays, out)
+unsafe fn packet_avx512<P: Primitives + ?Sized, const W: usize, N: Layout<W>>(bvh: &WideBvh<W, N>, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
+    packet::closest::<P, W, N, true>(bvh, prims, rays, out)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,avx512f,avx512vl,bmi1,bmi2")]
-unsafe fn any_avx512<P: Primitives + ?Sized, const W: usize, const COUNT: bool>(bvh: &WideBvh<W>, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
-    traverse::any::<P, W, true, COUNT>(bvh, prims, ray, c)
+unsafe fn any_avx512<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
+    traverse::any::<P, W, N, true, COUNT>(bvh, prims, ray, c)
 }
 
-impl<const W: usize> Accel for WideBvh<W> {
+impl<const W: usize, N: Layout<W>> Accel for WideBvh<W, N> {
     #[inline]
     fn intersect<P: Primitives + ?Sized>(&self, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
         self.closest_dispatch::<P, true>(prims, ray, c)
@@ -243,7 +278,7 @@ impl<const W: usize> Accel for WideBvh<W> {
             name: self.name.into(),
             build_ms: self.build_ms,
             primitives: self.primitives,
-            memory_bytes: self.nodes.len() * std::mem::size_of::<WideNode<W>>() + self.blocks.len() * std::mem::size_of::<TriBlock>(),
+            memory_bytes: self.nodes.len() * std::mem::size_of::<N>() + self.blocks.len() * std::mem::size_of::<TriBlock>(),
             ..Default::default()
         };
         let root_area = (self.root_bounds.half_area() as f64).max(f64::MIN_POSITIVE);
@@ -265,6 +300,7 @@ impl<const W: usize> Accel for WideBvh<W> {
         s.sah_cost = cost;
         let blocks_used = self.blocks.iter().map(|b| b.prim.iter().filter(|&&p| p != EMPTY).count()).sum::<usize>();
         s.note("width", W);
+        s.note("boxes", N::NAME);
         s.note("kernel", format!("{:?}", self.kernel));
         s.note("block fill", format!("{:.0}%", 100.0 * blocks_used as f64 / (4 * self.blocks.len()).max(1) as f64));
         s.note("bytes/triangle", format!("{:.1}", s.memory_bytes as f64 / self.primitives.max(1) as f64));
@@ -324,7 +360,7 @@ impl<const W: usize> Accel for WideBvh<W> {
                     return;
                 }
                 reached[i] = true;
-                let n = &self.nodes[i];
+                let n = self.nodes[i].with_decoded(|n| *n);
                 for lane in 0..W {
                     let cb = n.child_bounds(lane);
                     if n.child[lane] == EMPTY {

@@ -1,7 +1,11 @@
 //! The wide BVH's memory layout: `W`-wide nodes of child boxes in SoA form (one SIMD
-//! register per bound), and leaves of precomputed triangles four at a time.
+//! register per bound), and leaves of precomputed triangles four at a time. How a node
+//! stores its boxes is a [`Layout`]: f32 ([`WideNode`]) or quantised
+//! ([`QuantNode`](super::quant::QuantNode)).
 
 use raylab_core::{Aabb, Vec3};
+
+use super::kernels::RayBoxes;
 
 /// A child slot's reference: an interior node index, or [`LEAF`] with a range of
 /// [`TriBlock`]s, or [`EMPTY`].
@@ -64,6 +68,50 @@ impl<const W: usize> WideNode<W> {
     pub fn child_bounds(&self, lane: usize) -> Aabb {
         let g = |k: usize| Vec3::new(self.bounds[k][lane], self.bounds[k + 1][lane], self.bounds[k + 2][lane]);
         Aabb { min: g(0), max: g(3) }
+    }
+}
+
+/// How a `W`-wide node stores its child boxes and references. Traversal, statistics and
+/// validation are written once against this; a layout only encodes, decodes and runs its
+/// box test.
+pub trait Layout<const W: usize>: Copy + std::fmt::Debug + Send + Sync + 'static {
+    /// Short name for statistics ("f32", "quantised").
+    const NAME: &'static str;
+
+    /// Lays out `node`. A decoded box contains the original one (it may only grow).
+    fn encode(node: &WideNode<W>) -> Self;
+
+    /// Calls `f` with the f32 node this one decodes to: the boxes the box test uses.
+    fn with_decoded<R>(&self, f: impl FnOnce(&WideNode<W>) -> R) -> R;
+
+    fn child(&self, lane: usize) -> ChildRef;
+
+    /// Which children the ray enters within `[r.t_min, t_max]` (bit `l` for lane `l`), and
+    /// their entry distances: the same answer as [`boxes_portable`](super::kernels::boxes_portable)
+    /// on the decoded node, with SIMD or without.
+    fn boxes<const SIMD: bool>(&self, r: &RayBoxes, t_max: f32, tnear: &mut [f32; W]) -> u32;
+}
+
+impl<const W: usize> Layout<W> for WideNode<W> {
+    const NAME: &'static str = "f32";
+
+    fn encode(node: &WideNode<W>) -> Self {
+        *node
+    }
+
+    #[inline(always)]
+    fn with_decoded<R>(&self, f: impl FnOnce(&WideNode<W>) -> R) -> R {
+        f(self)
+    }
+
+    #[inline(always)]
+    fn child(&self, lane: usize) -> ChildRef {
+        self.child[lane]
+    }
+
+    #[inline(always)]
+    fn boxes<const SIMD: bool>(&self, r: &RayBoxes, t_max: f32, tnear: &mut [f32; W]) -> u32 {
+        super::traverse::child_boxes::<W, SIMD>(self, r, t_max, tnear)
     }
 }
 

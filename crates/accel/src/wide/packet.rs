@@ -17,7 +17,7 @@ use raylab_core::Ray;
 #[cfg(target_arch = "x86_64")]
 use super::kernels::slabs_avx2;
 use super::kernels::{RayBoxes, ROBUST_FAR};
-use super::node::{is_leaf, ChildRef, WideNode, EMPTY};
+use super::node::{is_leaf, ChildRef, Layout, WideNode, EMPTY};
 use super::traverse::{block_closest, child_boxes, leaf_slice, STACK};
 use super::WideBvh;
 use crate::{Hit, Primitives};
@@ -107,7 +107,7 @@ unsafe fn node_boxes_avx2(node: &WideNode<8>, rb: &[RayBoxes; PACKET], far: &[f3
 
 /// Closest hits of `rays` (at most [`PACKET`]) into `out` (as long as `rays`).
 #[inline(always)]
-pub(super) fn closest<P: Primitives + ?Sized, const W: usize, const SIMD: bool>(bvh: &WideBvh<W>, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
+pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SIMD: bool>(bvh: &WideBvh<W, N>, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
     let n = rays.len();
     assert!(n <= PACKET && out.len() == n, "a packet holds at most {PACKET} rays and as many answers");
     out.fill(None);
@@ -137,11 +137,12 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, const SIMD: bool>(
             // Per child: the rays entering it and their least entry distance.
             let mut entered = [0 as RayMask; W];
             let mut nearest = [f32::INFINITY; W];
-            let any = node_boxes::<W, SIMD>(node, &rb, &far, active, &mut entered, &mut nearest);
+            // A quantised node is decoded once for the whole packet.
+            let any = node.with_decoded(|n| node_boxes::<W, SIMD>(n, &rb, &far, active, &mut entered, &mut nearest));
             if any != 0 {
                 if any & (any - 1) == 0 {
                     let l = any.trailing_zeros() as usize;
-                    cur = node.child[l];
+                    cur = node.child(l);
                     active = entered[l];
                     continue 'walk;
                 }
@@ -153,9 +154,9 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, const SIMD: bool>(
                 if rest & (rest - 1) == 0 {
                     let (first, second) = (any.trailing_zeros() as usize, rest.trailing_zeros() as usize);
                     let (near, far) = if key(second) < key(first) { (second, first) } else { (first, second) };
-                    stack[sp] = MaybeUninit::new(Entry { node: node.child[far], rays: entered[far], t: nearest[far] });
+                    stack[sp] = MaybeUninit::new(Entry { node: node.child(far), rays: entered[far], t: nearest[far] });
                     sp += 1;
-                    cur = node.child[near];
+                    cur = node.child(near);
                     active = entered[near];
                     continue 'walk;
                 }
@@ -173,11 +174,11 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, const SIMD: bool>(
                 }
                 for &key in keys[1..k].iter().rev() {
                     let l = (key & lane_bits) as usize;
-                    stack[sp] = MaybeUninit::new(Entry { node: node.child[l], rays: entered[l], t: nearest[l] });
+                    stack[sp] = MaybeUninit::new(Entry { node: node.child(l), rays: entered[l], t: nearest[l] });
                     sp += 1;
                 }
                 let l = (keys[0] & lane_bits) as usize;
-                cur = node.child[l];
+                cur = node.child(l);
                 active = entered[l];
                 continue 'walk;
             }

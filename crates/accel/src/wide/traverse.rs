@@ -14,7 +14,7 @@ use raylab_core::Ray;
 
 use super::kernels::{boxes_portable, triangle_candidates, RayBoxes, ROBUST_FAR};
 
-use super::node::{is_leaf, leaf_blocks, ChildRef, TriBlock, WideNode, EMPTY};
+use super::node::{is_leaf, leaf_blocks, ChildRef, Layout, TriBlock, WideNode, EMPTY};
 use super::WideBvh;
 use crate::{Counters, Hit, PrimHit, Primitives};
 
@@ -169,13 +169,13 @@ fn leaf_any<P: Primitives + ?Sized, const SIMD: bool, const COUNT: bool>(blocks:
 }
 
 #[inline(always)]
-pub(super) fn leaf_slice<const W: usize>(bvh: &WideBvh<W>, r: ChildRef) -> &[TriBlock] {
+pub(super) fn leaf_slice<const W: usize, N: Layout<W>>(bvh: &WideBvh<W, N>, r: ChildRef) -> &[TriBlock] {
     let (first, n) = leaf_blocks(r);
     &bvh.blocks[first..first + n]
 }
 
 #[inline(always)]
-pub(super) fn closest<P: Primitives + ?Sized, const W: usize, const SIMD: bool, const COUNT: bool>(bvh: &WideBvh<W>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
+pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SIMD: bool, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
     if COUNT {
         c.rays += 1;
     }
@@ -199,11 +199,11 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, const SIMD: bool, 
         } else {
             let node = &bvh.nodes[cur as usize];
             let mut tnear = [0.0f32; W];
-            let mask = child_boxes::<W, SIMD>(node, &rb, ray.t_max * ROBUST_FAR, &mut tnear);
+            let mask = node.boxes::<SIMD>(&rb, ray.t_max * ROBUST_FAR, &mut tnear);
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
                 if mask & (mask - 1) == 0 {
-                    cur = node.child[first];
+                    cur = node.child(first);
                     continue 'walk;
                 }
                 let rest = mask & (mask - 1);
@@ -213,9 +213,9 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, const SIMD: bool, 
                     let second = rest.trailing_zeros() as usize;
                     let key = |l: usize| (tnear[l].to_bits() & !(W as u32 - 1)) | l as u32;
                     let (near, far) = if key(second) < key(first) { (second, first) } else { (first, second) };
-                    stack[sp] = MaybeUninit::new(Entry { node: node.child[far], t: tnear[far] });
+                    stack[sp] = MaybeUninit::new(Entry { node: node.child(far), t: tnear[far] });
                     sp += 1;
-                    cur = node.child[near];
+                    cur = node.child(near);
                     continue 'walk;
                 }
                 // Sort the hit lanes by entry distance: keys are the distance's bits (in
@@ -238,10 +238,10 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, const SIMD: bool, 
                 }
                 for &key in keys[1..n].iter().rev() {
                     let l = (key & lane_bits) as usize;
-                    stack[sp] = MaybeUninit::new(Entry { node: node.child[l], t: tnear[l] });
+                    stack[sp] = MaybeUninit::new(Entry { node: node.child(l), t: tnear[l] });
                     sp += 1;
                 }
-                cur = node.child[(keys[0] & lane_bits) as usize];
+                cur = node.child((keys[0] & lane_bits) as usize);
                 continue 'walk;
             }
         }
@@ -265,7 +265,7 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, const SIMD: bool, 
 }
 
 #[inline(always)]
-pub(super) fn any<P: Primitives + ?Sized, const W: usize, const SIMD: bool, const COUNT: bool>(bvh: &WideBvh<W>, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
+pub(super) fn any<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SIMD: bool, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
     if COUNT {
         c.rays += 1;
     }
@@ -291,13 +291,13 @@ pub(super) fn any<P: Primitives + ?Sized, const W: usize, const SIMD: bool, cons
         } else {
             let node = &bvh.nodes[cur as usize];
             let mut tnear = [0.0f32; W];
-            let mut mask = child_boxes::<W, SIMD>(node, &rb, ray.t_max * ROBUST_FAR, &mut tnear);
+            let mut mask = node.boxes::<SIMD>(&rb, ray.t_max * ROBUST_FAR, &mut tnear);
             if mask != 0 {
                 // Any hit will do: no ordering, the first lane is entered, the rest pushed.
-                cur = node.child[mask.trailing_zeros() as usize];
+                cur = node.child(mask.trailing_zeros() as usize);
                 mask &= mask - 1;
                 while mask != 0 {
-                    stack[sp] = MaybeUninit::new(node.child[mask.trailing_zeros() as usize]);
+                    stack[sp] = MaybeUninit::new(node.child(mask.trailing_zeros() as usize));
                     sp += 1;
                     mask &= mask - 1;
                 }

@@ -121,7 +121,7 @@ pub fn run(a: &BenchArgs, peers: &str) -> Result<()> {
 /// Wide layouts copy the triangles into their leaf blocks and never read the mesh while
 /// tracing; the others index into it, so its positions and indices count as theirs.
 fn reads_mesh(k: AccelKind) -> bool {
-    !matches!(k, AccelKind::Bvh8 | AccelKind::Bvh4 | AccelKind::Bvh8Sbvh)
+    !matches!(k, AccelKind::Bvh8 | AccelKind::Bvh4 | AccelKind::Bvh8Sbvh | AccelKind::Bvh8Q)
 }
 
 fn bench_scene(a: &BenchArgs, path: Option<&PathBuf>, accels: &[AccelKind], peer_kinds: &[PeerKind], kinds: &[RayKind], threads: usize) -> Result<SceneFigures> {

@@ -36,7 +36,7 @@ pub struct TraceArgs {
     /// other structures trace the packet's rays one by one)
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=raylab_accel::PACKET as i64))]
     pub packet: Option<u32>,
-    /// Kernels of the wide BVHs (bvh4, bvh8, bvh8-sbvh): the default (simd where the CPU
+    /// Kernels of the wide BVHs (bvh4, bvh8, bvh8-sbvh, bvh8q): the default (simd where the CPU
     /// runs it), or one forced to compare them (a kernel the CPU lacks falls back to the
     /// next best; all give the same answers)
     #[arg(long, default_value = "auto", value_enum)]
