@@ -59,7 +59,7 @@ fn simd_and_portable_agree_on_soups_and_degenerate_rays() {
 
 #[test]
 fn simd_and_portable_agree_on_the_bunny() {
-    let soup = kit::read_obj_triangles(&kit::shared_scenes().join("bunny_4968.obj"));
+    let soup = kit::read_obj_triangles(&kit::asset("bunny_4968.obj"));
     let b = soup.bounds();
     let mut rng = Pcg32::new(22, 1);
     let rays = kit::random_rays(&mut rng, 3000, &Aabb::new(b.min - b.extent(), b.max + b.extent()), &b);
@@ -70,7 +70,7 @@ fn simd_and_portable_agree_on_the_bunny() {
 /// one, at most four triangles per block, and reports its layout.
 #[test]
 fn collapse_shape_on_the_bunny() {
-    let soup = kit::read_obj_triangles(&kit::shared_scenes().join("bunny_4968.obj"));
+    let soup = kit::read_obj_triangles(&kit::asset("bunny_4968.obj"));
     let bin = AnyAccel::build(AccelKind::Bvh, &soup, &BuildOptions::default()).stats();
     for (kind, width) in [(AccelKind::Bvh8, 8usize), (AccelKind::Bvh4, 4)] {
         let s = AnyAccel::build(kind, &soup, &BuildOptions::default()).stats();
@@ -182,7 +182,7 @@ fn camera_tiles(eye: Vec3, target: Vec3, fov: f32, n: usize) -> Vec<Ray> {
 
 #[test]
 fn packets_answer_as_single_rays_coherent_and_incoherent() {
-    let bunny = kit::read_obj_triangles(&kit::shared_scenes().join("bunny_4968.obj"));
+    let bunny = kit::read_obj_triangles(&kit::asset("bunny_4968.obj"));
     let b = bunny.bounds();
     let centre = 0.5 * (b.min + b.max);
     // Coherent tiles framing the bunny with margin: many rays miss.
@@ -233,7 +233,7 @@ fn packet_edge_cases() {
 #[test]
 fn build_quality_picks_the_builder() {
     use raylab_accel::BuildQuality;
-    let soup = kit::read_obj_triangles(&kit::shared_scenes().join("bunny_4968.obj"));
+    let soup = kit::read_obj_triangles(&kit::asset("bunny_4968.obj"));
     let b = soup.bounds();
     let mut rng = Pcg32::new(26, 1);
     let rays = kit::random_rays(&mut rng, 500, &Aabb::new(b.min - b.extent(), b.max + b.extent()), &b);
@@ -263,7 +263,7 @@ fn build_quality_picks_the_builder() {
 /// node visits, the same triangle blocks, and nodes of 96 bytes instead of 224.
 #[test]
 fn quantised_nodes_answer_as_bvh8() {
-    let soup = kit::read_obj_triangles(&kit::shared_scenes().join("bunny_4968.obj"));
+    let soup = kit::read_obj_triangles(&kit::asset("bunny_4968.obj"));
     let b = soup.bounds();
     let mut rng = Pcg32::new(27, 1);
     let rays = kit::random_rays(&mut rng, 3000, &Aabb::new(b.min - b.extent(), b.max + b.extent()), &b);
