@@ -283,3 +283,35 @@ fn quantised_nodes_answer_as_bvh8() {
     assert_eq!(sq.memory_bytes, blocks + 96 * sq.interior_nodes, "96-byte nodes, the same blocks");
     assert!(sq.notes.iter().any(|(k, v)| k == "boxes" && v == "quantised"));
 }
+
+/// The leaf rule, on a binary tree written by hand: two clusters of four triangles, each a
+/// binary node over two leaves of two. A subtree of at most four references is one leaf (one
+/// full block), never opened to fill the wide node's free slots: the 8-wide root gets two
+/// leaves of four, not four leaves of two.
+#[test]
+fn subtrees_of_four_stay_one_leaf() {
+    use raylab_accel::bvh::{Bvh, BvhNode};
+    use raylab_accel::{QuantNode, WideBvh};
+    let tri = |x: f32, k: f32| [Vec3::new(x, k, 0.0), Vec3::new(x + 1.0, k, 0.0), Vec3::new(x, k + 1.0, 0.5)];
+    let soup = Soup::triangles((0..8).map(|i| tri(if i < 4 { 0.0 } else { 10.0 }, (i % 4) as f32)).collect::<Vec<_>>());
+    let b = |r: std::ops::Range<u32>| r.fold(Aabb::EMPTY, |a, p| a.union(Primitives::bounds(&soup, p)));
+    let nodes = vec![
+        BvhNode::interior(b(0..8), 1),
+        BvhNode::interior(b(0..4), 3),
+        BvhNode::interior(b(4..8), 5),
+        BvhNode::leaf(b(0..2), 0, 2),
+        BvhNode::leaf(b(2..4), 2, 2),
+        BvhNode::leaf(b(4..6), 4, 2),
+        BvhNode::leaf(b(6..8), 6, 2),
+    ];
+    let bin = Bvh::from_parts(nodes, (0..8).collect(), 8, "hand-made");
+    bin.validate(&soup).unwrap();
+    let wide = WideBvh::<8>::from_binary(&bin, &soup, "bvh8");
+    let quant = WideBvh::<8, QuantNode>::from_binary(&bin, &soup, "bvh8q");
+    for s in [wide.stats(), quant.stats()] {
+        assert_eq!((s.interior_nodes, s.leaves), (1, 2), "{}: {s}", s.name);
+        assert_eq!(s.leaf_histogram[4], 2, "{}: two leaves of four", s.name);
+    }
+    assert_eq!(wide.blocks.len(), 2);
+    assert!(wide.blocks.iter().all(|blk| blk.prim.iter().all(|&p| p != u32::MAX)), "both blocks full");
+}
