@@ -213,6 +213,42 @@ mod tests {
         assert_eq!(q.occupied, 0b11);
     }
 
+    /// The step is the least power of two whose 255 cells cover the node's extent, measured
+    /// from the node's least corner (here 100, not 0): extent 63.75 = 255 · 2^-2.
+    #[test]
+    fn the_step_covers_the_extent_from_the_least_corner() {
+        let boxes = [Aabb::new(Vec3::splat(100.0), Vec3::splat(163.75)), Aabb::new(Vec3::splat(100.5), Vec3::splat(101.0))];
+        let q = QuantNode::encode(&node_of(&boxes));
+        assert_eq!(q.exp, [125; 3]);
+        assert_eq!(q.origin, [100.0; 3]);
+        assert_eq!((q.q[0][1], q.q[3][1]), (2, 4)); // 0.5 / 0.25 and 1.0 / 0.25
+        for (l, b) in boxes.iter().enumerate() {
+            assert_eq!(decoded(&q, l), *b);
+        }
+    }
+
+    /// Where the f64 estimates round, the f32 checks repair them. With a corner at -2^24
+    /// and a step of 2^17, `2^24 ∓ 10^-30` rounds to 2^24 in f64, so the estimates for a box
+    /// [-10^-30, 10^-30] are cell 128 on both sides, which decodes to 0: outside the box on
+    /// both sides; the checks move them to 127 and 129. And with a corner at -255 and a
+    /// maximum of 10^-30, the extent rounds to 255 (a step of 1, whose last cell decodes to
+    /// 0 < 10^-30): the check doubles the step.
+    #[test]
+    fn rounding_in_the_estimates_is_repaired() {
+        let c = 2f32.powi(24);
+        let tiny = Aabb::new(Vec3::splat(-1e-30), Vec3::splat(1e-30));
+        let q = QuantNode::encode(&node_of(&[Aabb::new(Vec3::splat(-c), Vec3::splat(127.0 * 2f32.powi(17))), tiny]));
+        assert_eq!(q.exp, [17 + 127; 3]);
+        assert_eq!((q.q[0][1], q.q[3][1]), (127, 129));
+        assert!(decoded(&q, 1).contains_box(&tiny));
+        let wide = Aabb::new(Vec3::splat(-255.0), Vec3::ZERO);
+        let up = Aabb::new(Vec3::ZERO, Vec3::splat(1e-30));
+        let q = QuantNode::encode(&node_of(&[wide, up]));
+        assert_eq!(q.exp, [1 + 127; 3]);
+        assert!(decoded(&q, 0).contains_box(&wide) && decoded(&q, 1).contains_box(&up));
+        assert_eq!(q.q[3][1], 128); // -255 + 128 · 2 = 1, the first cell end at or above 10^-30
+    }
+
     /// Random boxes, at scales from 1e-30 to 1e30 and far from the origin: every decoded
     /// box contains its original and is at most one grid step larger on each side.
     #[test]
