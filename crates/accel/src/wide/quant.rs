@@ -305,6 +305,14 @@ mod tests {
         assert_eq!(boxes_portable(&q, &RayBoxes::new(&ray), f32::INFINITY, &mut tnear), 0b11);
         // The first box is entered at t = 1 (the corner 0), the second at t = 3.
         assert_eq!(&tnear[..2], &[1.0, 3.0]);
+        // Decoded (for packets, statistics, validation), unused lanes are the f32 layout's
+        // empty slots: an inverted infinite box that no slab test enters.
+        q.with_decoded(|n| {
+            for l in 2..8 {
+                assert_eq!(n.child[l], EMPTY);
+                assert!((0..3).all(|r| n.bounds[r][l] == f32::INFINITY && n.bounds[3 + r][l] == f32::NEG_INFINITY), "lane {l}");
+            }
+        });
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx2") {
             let mut t2 = [0.0; 8];
