@@ -360,3 +360,214 @@ fn area(geometry: &Geometry, prim: u32) -> f32 {
         PrimRef::Curve { .. } | PrimRef::Patch { .. } => unreachable!("curves and patches do not emit light"),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    //! Hand-worked values for the area lights' choice, samples and densities, seen from the
+    //! origin: a 2 × 2 square light A at height 1 facing down (radiance 3, power 4·3 = 12)
+    //! and a 1 × 1 square light B at depth 2 facing up (radiance 2, power 2), after a
+    //! non-emitting triangle (prim 0): A is prims 1 and 2, B prims 3 and 4.
+    use super::*;
+    use crate::shape::{Sphere, TriangleMesh};
+    use raylab_core::Transform;
+
+    fn quad(corners: [Vec3; 4], le: f32) -> TriangleMesh {
+        TriangleMesh { name: "quad".into(), positions: corners.to_vec(), indices: vec![[0, 1, 2], [0, 2, 3]], emission: Rgb::splat(le), ..Default::default() }
+    }
+
+    /// Light A's corners: (b − a) × (c − a) = (2, 0, 0) × (2, 0, 2) = (0, −4, 0), facing down;
+    /// edges e1 = b − a along x, e2 = d − a along z.
+    const A: [Vec3; 4] = [Vec3::new(-1.0, 1.0, -1.0), Vec3::new(1.0, 1.0, -1.0), Vec3::new(1.0, 1.0, 1.0), Vec3::new(-1.0, 1.0, 1.0)];
+
+    fn scene() -> Geometry {
+        let mut g = Geometry::default();
+        g.add_mesh(TriangleMesh { name: "dark".into(), positions: vec![Vec3::new(5.0, 0.0, 0.0), Vec3::new(6.0, 0.0, 0.0), Vec3::new(5.0, 1.0, 0.0)], indices: vec![[0, 1, 2]], ..Default::default() });
+        g.add_mesh(quad(A, 3.0));
+        // (0, 0, 1) × (1, 0, 1) = (0, 1, 0): facing up, towards the origin.
+        g.add_mesh(quad([Vec3::new(2.0, -2.0, -0.5), Vec3::new(2.0, -2.0, 0.5), Vec3::new(3.0, -2.0, 0.5), Vec3::new(3.0, -2.0, -0.5)], 2.0));
+        g
+    }
+
+    fn close(a: f32, b: f64, rel: f64) -> bool {
+        (a as f64 - b).abs() <= rel * b.abs()
+    }
+
+    #[test]
+    fn emitters_are_chosen_by_power_and_densities_follow_by_hand() {
+        let g = scene();
+        let lights = AreaLights::new(&g, 4);
+        assert!(!lights.is_empty());
+        assert_eq!(lights.len(), 4);
+        let down = Vec3::new(0.0, -1.0, 0.0);
+        // Uniform: A's triangle 0 (half of A's 12/14, area 2) at q = (0.5, 1, −0.5):
+        // d² = 1.5, cos = 1/√1.5, so p = (6/14)/2 · d²/cos = (3/14)·1.5^1.5.
+        let q = Vec3::new(0.5, 1.0, -0.5);
+        let uniform = lights.pdf(&g, LightSampling::Uniform, 1, Vec3::ZERO, q, down);
+        assert!(close(uniform, 3.0 / 14.0 * 1.5f64.powf(1.5), 1e-5), "{uniform}");
+        // B's triangle at its nearest corner (2, −2, −0.5) with B's 2/14 over area 1:
+        // (1/14)/0.5 · d²/cos, d² = 8.25, cos = 2/√8.25.
+        let qb = Vec3::new(2.0, -2.0, -0.5);
+        let b = lights.pdf(&g, LightSampling::Uniform, 3, Vec3::ZERO, qb, Vec3::Y);
+        assert!(close(b, 1.0 / 7.0 * 8.25 * 8.25f64.sqrt() / 2.0, 1e-5), "{b}");
+        // Solid angle: A is a square of half side 1 at distance 1, Ω = 4·asin(1/2) = 2π/3, so
+        // p = (12/14)/(2π/3) = 9/(7π) for a direction towards either triangle.
+        for (strategy, prim) in [(LightSampling::SolidAngle, 1), (LightSampling::SolidAngle, 2), (LightSampling::Mis, 2), (LightSampling::Bsdf, 1)] {
+            let p = lights.pdf(&g, strategy, prim, Vec3::ZERO, q, down);
+            assert!(close(p, 9.0 / (7.0 * std::f64::consts::PI), 1e-5), "{strategy:?} {prim}: {p}");
+        }
+        // B by solid angle: x in [2, 3], z in [−0.5, 0.5] at distance 2, by inclusion and
+        // exclusion of atan(xz / (d·√(x² + z² + d²))) over the corners.
+        let f = |x: f64, z: f64| (x * z / (2.0 * (x * x + z * z + 4.0).sqrt())).atan();
+        let omega = f(3.0, 0.5) - f(2.0, 0.5) - f(3.0, -0.5) + f(2.0, -0.5);
+        let p = lights.pdf(&g, LightSampling::SolidAngle, 4, Vec3::ZERO, qb, Vec3::Y);
+        assert!(close(p, 2.0 / 14.0 / omega, 1e-4), "{p} against {}", 2.0 / 14.0 / omega);
+        // Not an emitter, out of range, or seen edge-on (n ⊥ q): no density.
+        assert_eq!(lights.pdf(&g, LightSampling::Uniform, 0, Vec3::ZERO, Vec3::new(5.0, 0.5, 0.0), Vec3::Z), 0.0);
+        assert_eq!(lights.pdf(&g, LightSampling::Uniform, 9, Vec3::ZERO, q, down), 0.0);
+        assert_eq!(lights.pdf(&g, LightSampling::Uniform, 1, Vec3::ZERO, q, Vec3::new(1.0, 0.0, 1.0)), 0.0);
+    }
+
+    #[test]
+    fn samples_pick_emitters_by_the_cdf_and_report_their_density() {
+        let g = scene();
+        let lights = AreaLights::new(&g, 4);
+        // The choice CDF over prims 1..=4 is 6/14, 12/14, 13/14, 1: u_choice 0.1 picks A's
+        // first triangle, 0.5 its second, 0.9 B's first, 0.99 B's second.
+        let u = Vec2::new(0.3, 0.6);
+        for (u_choice, light) in [(0.1f32, 'A'), (0.5, 'A'), (0.9, 'B'), (0.99, 'B')] {
+            let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 1.0, LightSampling::Uniform, u_choice, u).unwrap();
+            let q = s.wi * s.dist;
+            let (height, le, n) = if light == 'A' { (1.0, 3.0, -Vec3::Y) } else { (-2.0, 2.0, Vec3::Y) };
+            assert!((q.y - height).abs() < 1e-5, "{u_choice}: {q}");
+            assert_eq!(s.le, Rgb::splat(le));
+            // Area density (half the light's power share over half its area) to solid angle.
+            let share = if light == 'A' { 6.0 / 14.0 / 2.0 } else { 1.0 / 14.0 / 0.5 };
+            let expected = share * (s.dist as f64).powi(2) / n.dot(-s.wi) as f64;
+            assert!(close(s.pdf, expected, 1e-5), "{u_choice}: {} against {expected}", s.pdf);
+            // The same by solid angle: A's 12/14 over 2π/3.
+            let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 1.0, LightSampling::SolidAngle, u_choice, u).unwrap();
+            assert!((s.wi.length() - 1.0).abs() < 1e-5 && ((s.wi * s.dist).y - height).abs() < 1e-4, "{u_choice}: {} {}", s.wi, s.dist);
+            if light == 'A' {
+                assert!(close(s.pdf, 9.0 / (7.0 * std::f64::consts::PI), 1e-5), "{}", s.pdf);
+            }
+        }
+        // From above A (its back) nothing is lit, by any strategy.
+        for strategy in [LightSampling::Uniform, LightSampling::SolidAngle, LightSampling::Cells] {
+            assert!(lights.sample(&g, &[], Vec3::new(0.0, 2.0, 0.0), &|_| 1.0, strategy, 0.1, u).is_none(), "{strategy:?}");
+        }
+        assert!(LightSampling::Mis.samples_lights() && LightSampling::Uniform.samples_lights() && !LightSampling::Bsdf.samples_lights());
+    }
+
+    #[test]
+    fn cells_are_chosen_by_their_centres_light_with_a_uniform_share() {
+        // A alone, k = 2: cells in order (0, 0), (1, 0), (0, 1), (1, 1) along (e1, e2), centres
+        // (∓0.5, 1, ∓0.5). A receiver that takes light only from +x weighs cells 1 and 3
+        // equally (mirror images in z) and 0 and 2 not at all: probabilities 0.9·½ + 0.1/4 =
+        // 0.475 and 0.1/4 = 0.025, CDF 0.025, 0.5, 0.525, 1. The cell's point has area density
+        // prob·4 cells / area 4, in solid angle prob·d²/cos = prob·1.5^1.5 at a cell's centre.
+        let mut g = Geometry::default();
+        g.add_mesh(quad(A, 3.0));
+        let lights = AreaLights::new(&g, 2);
+        let receiver = |w: Vec3| w.x.max(0.0);
+        let centre = Vec2::splat(0.5);
+        // u_choice in A's first triangle (CDF 0.5) is stretched to 2·u_choice, in the second
+        // to 2·(u_choice − 0.5).
+        for (u_choice, cell, prob) in [(0.005f32, Vec3::new(-0.5, 1.0, -0.5), 0.025), (0.2, Vec3::new(0.5, 1.0, -0.5), 0.475), (0.6, Vec3::new(0.5, 1.0, -0.5), 0.475), (0.26, Vec3::new(-0.5, 1.0, 0.5), 0.025), (0.9, Vec3::new(0.5, 1.0, 0.5), 0.475)] {
+            let s = lights.sample(&g, &[], Vec3::ZERO, &receiver, LightSampling::Cells, u_choice, centre).unwrap();
+            assert!((s.wi * s.dist - cell).length() < 1e-5, "{u_choice}: {} against {cell}", s.wi * s.dist);
+            assert!(close(s.pdf, prob * 1.5f64.powf(1.5), 1e-5), "{u_choice}: {} against {}", s.pdf, prob * 1.5f64.powf(1.5));
+            assert_eq!(s.le, Rgb::splat(3.0));
+        }
+        // A point inside a cell: cell (1, 1) at offset (0.25, 0.75) is st = (0.625, 0.875),
+        // (−1 + 1.25, 1, −1 + 1.75).
+        let s = lights.sample(&g, &[], Vec3::ZERO, &receiver, LightSampling::Cells, 0.9, Vec2::new(0.25, 0.75)).unwrap();
+        assert!((s.wi * s.dist - Vec3::new(0.25, 1.0, 0.75)).length() < 1e-5, "{}", s.wi * s.dist);
+        // A receiver that takes no light: every cell 1/4, the density of uniform area sampling.
+        let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 0.0, LightSampling::Cells, 0.2, centre).unwrap();
+        assert!(close(s.pdf, 0.25 * 1.5f64.powf(1.5), 1e-5), "{}", s.pdf);
+    }
+
+    #[test]
+    fn only_rectangles_are_sampled_by_solid_angle() {
+        // A sheared parallelogram (a + c = b + d, e1·e2 = 1): no spherical rectangle, so its
+        // solid-angle density is the area one, per triangle: (½)/2 · d²/cos = ¼·1.5^1.5 at
+        // (0.5, 1, −0.5) (area 4, each triangle 2, half the choice each).
+        let mut g = Geometry::default();
+        g.add_mesh(quad([Vec3::new(-1.0, 1.0, -1.0), Vec3::new(1.0, 1.0, -1.0), Vec3::new(1.5, 1.0, 1.0), Vec3::new(-0.5, 1.0, 1.0)], 1.0));
+        let lights = AreaLights::new(&g, 2);
+        let p = lights.pdf(&g, LightSampling::SolidAngle, 0, Vec3::ZERO, Vec3::new(0.5, 1.0, -0.5), -Vec3::Y);
+        assert!(close(p, 0.25 * 1.5f64.powf(1.5), 1e-5), "{p}");
+        // Its cells still work: four equal cells from a receiver taking nothing, 1/4 each, at
+        // cell (1, 0)'s centre st = (0.75, 0.25): a + 0.75·e1 + 0.25·e2 = (0.625, 1, −0.5).
+        let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 0.0, LightSampling::Cells, 0.2, Vec2::splat(0.5)).unwrap();
+        let q = Vec3::new(0.625, 1.0, -0.5);
+        assert!((s.wi * s.dist - q).length() < 1e-5, "{}", s.wi * s.dist);
+        assert!(close(s.pdf, 0.25 * q.length_squared() as f64 / (1.0 / q.length() as f64), 1e-5), "{}", s.pdf);
+        // A quadrilateral that is no parallelogram (d moved): each triangle on its own, even
+        // with the cells strategy: triangle 0 (a, b, c) has area 2, half the power of 2 + 2.5.
+        let mut g = Geometry::default();
+        g.add_mesh(quad([Vec3::new(-1.0, 1.0, -1.0), Vec3::new(1.0, 1.0, -1.0), Vec3::new(1.0, 1.0, 1.0), Vec3::new(-1.5, 1.0, 1.0)], 1.0));
+        let lights = AreaLights::new(&g, 2);
+        for strategy in [LightSampling::SolidAngle, LightSampling::Cells] {
+            let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 1.0, strategy, 0.1, Vec2::new(0.3, 0.6)).unwrap();
+            let expected = (2.0 / 4.5) / 2.0 * (s.dist as f64).powi(2) / s.wi.y as f64;
+            assert!(close(s.pdf, expected, 1e-5), "{strategy:?}: {} against {expected}", s.pdf);
+        }
+    }
+
+    #[test]
+    fn sphere_lights_are_sampled_uniformly_in_their_cone() {
+        // Radius 1 at distance 2: sin²θmax = 1/4, cos θmax = √3/2, the cap's solid angle
+        // 2π(1 − √3/2). u.x = 0 is the axis (the nearest point, at distance 1), u.x → 1 the
+        // silhouette (tangent, at distance √(4 − 1)), and cos θ = 1 − u.x(1 − cos θmax) between,
+        // hitting the sphere at 2cos θ − √(1 − 4 sin²θ).
+        let mut g = Geometry::default();
+        let c = Vec3::new(0.0, 0.0, 2.0);
+        g.add_sphere(Sphere { center: c, radius: 1.0, to_world: Transform::IDENTITY, material: Default::default(), emission: Rgb::splat(5.0) });
+        let lights = AreaLights::new(&g, 2);
+        let cos_max = 3f64.sqrt() / 2.0;
+        let cap = 1.0 / (2.0 * std::f64::consts::PI * (1.0 - cos_max));
+        for (ux, uy) in [(0.0f32, 0.3f32), (0.5, 0.3), (0.5, 0.8), (0.9, 0.1), (1.0 - f32::EPSILON / 2.0, 0.6)] {
+            let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(ux, uy)).unwrap();
+            let cos = 1.0 - ux as f64 * (1.0 - cos_max);
+            let sin2 = 1.0 - cos * cos;
+            assert!(close(s.wi.z, cos, 1e-5), "{ux}: wi {}", s.wi);
+            assert!(close(s.dist, 2.0 * cos - (1.0 - 4.0 * sin2).max(0.0).sqrt(), 2e-3), "{ux}: dist {}", s.dist);
+            assert!(((s.wi * s.dist - c).length() - 1.0).abs() < 1e-4, "{ux}: off the sphere");
+            assert!(close(s.pdf, cap, 1e-5), "{ux}: {}", s.pdf);
+            assert_eq!(s.le, Rgb::splat(5.0));
+        }
+        // u.y turns the direction about the axis: half a turn apart, mirror images.
+        let at = |uy: f32| lights.sample(&g, &[], Vec3::ZERO, &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(0.5, uy)).unwrap().wi;
+        let (w0, w1) = (at(0.1), at(0.6));
+        assert!((w0.x + w1.x).abs() < 1e-5 && (w0.y + w1.y).abs() < 1e-5 && (w0.z - w1.z).abs() < 1e-6, "{w0} {w1}");
+        assert!((at(0.35).x - w0.y).abs() < 1e-5 || (at(0.35).x + w0.y).abs() < 1e-5, "a quarter turn: {} {w0}", at(0.35));
+        // The density for a direction found otherwise is the cap's too; uniform sampling of
+        // the whole sphere (area 4π) gives the nearest point 1/(4π)·d²/cos = 1/(4π).
+        let near = Vec3::new(0.0, 0.0, 1.0);
+        assert!(close(lights.pdf(&g, LightSampling::SolidAngle, 0, Vec3::ZERO, near, -Vec3::Z), cap, 1e-5));
+        let p = lights.pdf(&g, LightSampling::Uniform, 0, Vec3::ZERO, near, -Vec3::Z);
+        assert!(close(p, 1.0 / (4.0 * std::f64::consts::PI), 1e-5), "{p}");
+        // From inside, the emitter's outside faces away: no sample.
+        assert!(lights.sample(&g, &[], c + Vec3::new(0.1, 0.2, 0.0), &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(0.4, 0.7)).is_none());
+    }
+
+    #[test]
+    fn tiny_sphere_caps_use_the_small_angle_expansion() {
+        // Radius 0.01 at distance 1: sin²θmax = 10⁻⁴, 1 − cos θmax = sin²θmax/2 + O(sin⁴) =
+        // 5·10⁻⁵ (to 2.5·10⁻⁵ relative; computed as 1 − cos in f32 it would lose ~10⁻³), so the
+        // density is 1/(2π·5·10⁻⁵), and sin²θ = 10⁻⁴·u.x.
+        let mut g = Geometry::default();
+        g.add_sphere(Sphere { center: Vec3::new(0.0, 1.0, 0.0), radius: 0.01, to_world: Transform::IDENTITY, material: Default::default(), emission: Rgb::ONE });
+        let lights = AreaLights::new(&g, 2);
+        let expected = 1.0 / (2.0 * std::f64::consts::PI * 5e-5);
+        for ux in [0.25f32, 0.5, 0.9] {
+            let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(ux, 0.2)).unwrap();
+            assert!(close(s.pdf, expected, 1e-4), "{}", s.pdf);
+            let sin2 = s.wi.cross(Vec3::Y).length_squared();
+            assert!(close(sin2, 1e-4 * ux as f64, 2e-3), "{ux}: sin² {sin2}");
+        }
+        let p = lights.pdf(&g, LightSampling::Mis, 0, Vec3::ZERO, Vec3::new(0.0, 0.99, 0.0), -Vec3::Y);
+        assert!(close(p, expected, 1e-4), "{p}");
+    }
+}
