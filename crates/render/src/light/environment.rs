@@ -201,9 +201,11 @@ mod tests {
         // The centre of texel (3, 0) worked out: φ = 3π/4, λ = π/4, p = (8/3) / (√2·π²).
         let w = Vec3::new(-0.5, std::f32::consts::FRAC_1_SQRT_2, 0.5);
         assert!((env.pdf(w) - 8.0 / 3.0 / (2f32.sqrt() * pi2)).abs() < 1e-6, "{}", env.pdf(w));
-        // At the poles the rows' solid angle vanishes: no density.
+        // At the poles the rows' solid angle vanishes: no density, and a sample that lands on
+        // the north pole (u.y = 0 is the top of row 0, t = 0) is refused.
         assert_eq!(env.pdf(Vec3::Y), 0.0);
         assert_eq!(env.pdf(-Vec3::Y), 0.0);
+        assert!(env.sample(Vec2::new(0.3, 0.0)).is_none());
     }
 
     #[test]
