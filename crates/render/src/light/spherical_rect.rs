@@ -239,6 +239,26 @@ mod tests {
     }
 
     #[test]
+    fn samples_invert_the_solid_angle_fractions() {
+        // u.x is the fraction of the solid angle in [x0, X] × [y0, y1] (inclusion and
+        // exclusion above), u.y the fraction of the column at X below Y (the column test's
+        // sin-elevation form, with dd² = X² + d²): so u built from a chosen (X, Y) must come
+        // back as that point. Off-axis, at distance 2 (at distance 1, z0·z0 and z0/z0 agree).
+        let (x0, x1, y0, y1, d) = (-1.0f64, 3.0, -0.5, 2.0, 2.0);
+        let r = SphericalRect::new(Vec3::ZERO, Vec3::new(-1.0, -0.5, 2.0), Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 2.5, 0.0));
+        let total = rect_solid_angle(x0, x1, y0, y1, d);
+        for x in [-0.5f64, 0.0, 1.0, 2.5] {
+            let dd2 = x * x + d * d;
+            let h = |y: f64| y / (dd2 + y * y).sqrt();
+            for y in [-0.25f64, 0.0, 1.0, 1.9] {
+                let u = Vec2::new((rect_solid_angle(x0, x, y0, y1, d) / total) as f32, ((h(y) - h(y0)) / (h(y1) - h(y0))) as f32);
+                let q = r.sample(u);
+                assert!((q - Vec3::new(x as f32, y as f32, 2.0)).length() < 1e-4, "u = {u}: {q} against ({x}, {y}, 2)");
+            }
+        }
+    }
+
+    #[test]
     fn samples_lie_on_the_rectangle_and_cover_it_by_solid_angle() {
         // Count samples per quarter of a rectangle seen off-axis: each quarter must get its
         // share of the solid angle, found by subdividing it.
