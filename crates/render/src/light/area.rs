@@ -516,6 +516,25 @@ mod tests {
     }
 
     #[test]
+    fn quads_within_the_tolerances_are_sampled_as_rectangles() {
+        // A 4 × 4 light at height 1 facing down, centred above the origin: Ω = 4·asin(4/5)
+        // (half side 2, distance 1, a²/(a² + d²) = 4/5), solid-angle density 1/Ω against the
+        // area one, (½)/8 at the foot, if it were not taken for a rectangle.
+        // (i) c off by 2·10⁻⁵: a + c − (b + d) is within 10⁻⁵ of the longer edge (4·10⁻⁵);
+        // (ii) c and d shifted by 2·10⁻⁵ along x: a parallelogram with e1·e2 = 8·10⁻⁵, within
+        // 10⁻⁵·|e1|·|e2| = 1.6·10⁻⁴ of a right angle.
+        let omega = 4.0 * (0.8f64).asin();
+        let (a, b) = (Vec3::new(-2.0, 1.0, -2.0), Vec3::new(2.0, 1.0, -2.0));
+        for (c, d) in [(Vec3::new(2.0 + 2e-5, 1.0, 2.0), Vec3::new(-2.0, 1.0, 2.0)), (Vec3::new(2.0 + 2e-5, 1.0, 2.0), Vec3::new(-2.0 + 2e-5, 1.0, 2.0))] {
+            let mut g = Geometry::default();
+            g.add_mesh(quad([a, b, c, d], 1.0));
+            let lights = AreaLights::new(&g, 2);
+            let p = lights.pdf(&g, LightSampling::SolidAngle, 0, Vec3::ZERO, Vec3::new(0.0, 1.0, 0.0), -Vec3::Y);
+            assert!(close(p, 1.0 / omega, 1e-4), "c {c}, d {d}: {p} against {}", 1.0 / omega);
+        }
+    }
+
+    #[test]
     fn sphere_lights_are_sampled_uniformly_in_their_cone() {
         // Radius 1 at distance 2: sin²θmax = 1/4, cos θmax = √3/2, the cap's solid angle
         // 2π(1 − √3/2). u.x = 0 is the axis (the nearest point, at distance 1), u.x → 1 the
