@@ -516,6 +516,38 @@ mod tests {
     }
 
     #[test]
+    fn textured_emission_is_read_where_the_sample_lands() {
+        // A with UVs (0, 0), (1, 0), (1, 1), (0, 1) at a, b, c, d (so uv = ((x + 1)/2, (z + 1)/2)
+        // on it) and a 2 × 2 nearest-texel emission texture: row 0 (v > ½) red, green; row 1
+        // blue, white. Seen from off the axis, every strategy's sample must carry the texel
+        // under its own point (2 × the texel), and lie on A at the distance it reports.
+        let mut g = Geometry::default();
+        g.add_mesh(TriangleMesh { uvs: vec![Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y], emission_texture: Some(crate::material::TextureId(0)), ..quad(A, 2.0) });
+        let texels = vec![Rgb::X, Rgb::Y, Rgb::Z, Rgb::ONE];
+        let textures = [Texture::Image(crate::texture::ImageTexture::new(2, 2, texels.clone(), crate::texture::Wrap::Clamp, crate::texture::Filter::Nearest).unwrap())];
+        let lights = AreaLights::new(&g, 2);
+        let p = Vec3::new(0.3, -0.5, 0.2);
+        let mut rng = raylab_core::Pcg32::new(7, 2);
+        let mut seen = [0; 4];
+        for _ in 0..200 {
+            let (u_choice, u) = (rng.next_f32(), rng.next_vec2());
+            for strategy in [LightSampling::Uniform, LightSampling::SolidAngle, LightSampling::Cells] {
+                let s = lights.sample(&g, &textures, p, &|_| 1.0, strategy, u_choice, u).unwrap();
+                let q = p + s.wi * s.dist;
+                assert!((q.y - 1.0).abs() < 1e-5 && q.x.abs() <= 1.0 + 1e-5 && q.z.abs() <= 1.0 + 1e-5, "{strategy:?}: {q} off A");
+                let uv = Vec2::new((q.x + 1.0) / 2.0, (q.z + 1.0) / 2.0);
+                if (uv.x - 0.5).abs() < 1e-3 || (uv.y - 0.5).abs() < 1e-3 {
+                    continue;
+                }
+                let texel = (uv.x >= 0.5) as usize + 2 * (uv.y < 0.5) as usize;
+                seen[texel] += 1;
+                assert_eq!(s.le, texels[texel] * 2.0, "{strategy:?}: at uv {uv}");
+            }
+        }
+        assert!(seen.iter().all(|&n| n > 50), "{seen:?}");
+    }
+
+    #[test]
     fn quads_within_the_tolerances_are_sampled_as_rectangles() {
         // A 4 × 4 light at height 1 facing down, centred above the origin: Ω = 4·asin(4/5)
         // (half side 2, distance 1, a²/(a² + d²) = 4/5), solid-angle density 1/Ω against the
@@ -567,6 +599,26 @@ mod tests {
         assert!(close(lights.pdf(&g, LightSampling::SolidAngle, 0, Vec3::ZERO, near, -Vec3::Z), cap, 1e-5));
         let p = lights.pdf(&g, LightSampling::Uniform, 0, Vec3::ZERO, near, -Vec3::Z);
         assert!(close(p, 1.0 / (4.0 * std::f64::consts::PI), 1e-5), "{p}");
+        // Uniform sampling takes points all over the sphere (the far side refused, facing
+        // away), at the area density 1/(4π)·d²/cos turned to solid angle, not the cap's.
+        let mut rng = raylab_core::Pcg32::new(3, 4);
+        let mut lit = 0;
+        for _ in 0..256 {
+            if let Some(s) = lights.sample(&g, &[], Vec3::ZERO, &|_| 1.0, LightSampling::Uniform, 0.5, rng.next_vec2()) {
+                let n = (s.wi * s.dist - c).normalize();
+                let expected = (s.dist as f64).powi(2) / (4.0 * std::f64::consts::PI * n.dot(-s.wi) as f64);
+                assert!(close(s.pdf, expected, 1e-4), "{} against {expected}", s.pdf);
+                lit += 1;
+            }
+        }
+        // The near side, (1 − r/d)/2 = ¼ of the sphere, takes about 64 of 256.
+        assert!((32..128).contains(&lit), "{lit} of 256 on the near side");
+        // Outside but within √2 of the centre (r² = 1 < d² = 1.44 < 2r): still the cone, with
+        // sin²θmax = 1/1.44.
+        let p = c - Vec3::new(0.0, 0.0, 1.2);
+        let s = lights.sample(&g, &[], p, &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(0.3, 0.3)).unwrap();
+        let cap = 1.0 / (2.0 * std::f64::consts::PI * (1.0 - (1.0 - 1.0 / 1.44f64).sqrt()));
+        assert!(close(s.pdf, cap, 1e-4), "{} against {cap}", s.pdf);
         // From inside, the emitter's outside faces away: no sample.
         assert!(lights.sample(&g, &[], c + Vec3::new(0.1, 0.2, 0.0), &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(0.4, 0.7)).is_none());
     }
