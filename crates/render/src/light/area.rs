@@ -539,12 +539,32 @@ mod tests {
                 if (uv.x - 0.5).abs() < 1e-3 || (uv.y - 0.5).abs() < 1e-3 {
                     continue;
                 }
+                if strategy == LightSampling::Uniform {
+                    // Half the choice over half the area 4, turned to solid angle from p; the
+                    // same from `pdf` for either triangle.
+                    let expected = 0.25 * (s.dist as f64).powi(2) / s.wi.y as f64;
+                    assert!(close(s.pdf, expected, 1e-4), "{} against {expected}", s.pdf);
+                    assert!(close(lights.pdf(&g, strategy, 0, p, q, -Vec3::Y), expected, 1e-4), "pdf at {q}");
+                }
                 let texel = (uv.x >= 0.5) as usize + 2 * (uv.y < 0.5) as usize;
                 seen[texel] += 1;
                 assert_eq!(s.le, texels[texel] * 2.0, "{strategy:?}: at uv {uv}");
             }
         }
         assert!(seen.iter().all(|&n| n > 50), "{seen:?}");
+    }
+
+    #[test]
+    fn a_mesh_is_a_parallelogram_only_with_both_triangles() {
+        // A's four corners but only the triangle (a, b, c) (d unused), and B after it: no
+        // parallelogram, so the triangle's solid-angle density is its area one, the whole
+        // choice over area 2: ½·d²/cos at (0.5, 1, −0.5), ½·1.5^1.5 (not 1/Ω of the square).
+        let mut g = Geometry::default();
+        g.add_mesh(TriangleMesh { indices: vec![[0, 1, 2]], ..quad(A, 3.0) });
+        g.add_mesh(quad([Vec3::new(2.0, -2.0, -0.5), Vec3::new(2.0, -2.0, 0.5), Vec3::new(3.0, -2.0, 0.5), Vec3::new(3.0, -2.0, -0.5)], 0.0));
+        let lights = AreaLights::new(&g, 2);
+        let p = lights.pdf(&g, LightSampling::SolidAngle, 0, Vec3::ZERO, Vec3::new(0.5, 1.0, -0.5), -Vec3::Y);
+        assert!(close(p, 0.5 * 1.5f64.powf(1.5), 1e-5), "{p}");
     }
 
     #[test]
@@ -619,6 +639,8 @@ mod tests {
         let s = lights.sample(&g, &[], p, &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(0.3, 0.3)).unwrap();
         let cap = 1.0 / (2.0 * std::f64::consts::PI * (1.0 - (1.0 - 1.0 / 1.44f64).sqrt()));
         assert!(close(s.pdf, cap, 1e-4), "{} against {cap}", s.pdf);
+        let q = p + s.wi * s.dist;
+        assert!(close(lights.pdf(&g, LightSampling::SolidAngle, 0, p, q, (q - c).normalize()), cap, 1e-4));
         // From inside, the emitter's outside faces away: no sample.
         assert!(lights.sample(&g, &[], c + Vec3::new(0.1, 0.2, 0.0), &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(0.4, 0.7)).is_none());
     }
