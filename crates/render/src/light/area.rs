@@ -488,6 +488,64 @@ mod tests {
     }
 
     #[test]
+    fn cell_weights_follow_the_documented_importance_from_off_centre() {
+        // From p = (0.3, 0, −0.6) the four cells' centres c lie at different distances: the
+        // weight is receiver(ω)·(n·−ω)/d²·lum(Le) (n = −y, so n·−ω = ω.y), with a receiver
+        // 0.1 + max(0, ω.x) + 2·max(0, ω.z) (an offset, so that scaling ω would show), and the
+        // probability 0.9·w/Σw + 0.1/4. Each cell's centre (u = ½) must come out with density
+        // prob·(4 cells / area 4)·d²/(n·−ω).
+        let mut g = Geometry::default();
+        g.add_mesh(quad(A, 3.0));
+        let lights = AreaLights::new(&g, 2);
+        let p = Vec3::new(0.3, 0.0, -0.6);
+        let receiver = |w: Vec3| 0.1 + w.x.max(0.0) + 2.0 * w.z.max(0.0);
+        let centres = [(-0.5f64, -0.5f64), (0.5, -0.5), (-0.5, 0.5), (0.5, 0.5)];
+        let geo = |(x, z): (f64, f64)| {
+            let d = (x - 0.3, 1.0, z + 0.6);
+            let d2 = d.0 * d.0 + d.1 * d.1 + d.2 * d.2;
+            let w = (d.0 / d2.sqrt(), d.1 / d2.sqrt(), d.2 / d2.sqrt());
+            (d2, w.1, (0.1 + w.0.max(0.0) + 2.0 * w.2.max(0.0)) * w.1 / d2 * 3.0)
+        };
+        let total: f64 = centres.iter().map(|&c| geo(c).2).sum();
+        let mut lo = 0.0;
+        for &(x, z) in &centres {
+            let (d2, cos, w) = geo((x, z));
+            let prob = 0.9 * w / total + 0.025;
+            // The middle of the cell's CDF interval, as u_choice in A's first triangle (×2).
+            let u_choice = ((lo + prob / 2.0) / 2.0) as f32;
+            lo += prob;
+            let s = lights.sample(&g, &[], p, &receiver, LightSampling::Cells, u_choice, Vec2::splat(0.5)).unwrap();
+            assert!((p + s.wi * s.dist - Vec3::new(x as f32, 1.0, z as f32)).length() < 1e-5, "cell ({x}, {z}): {}", p + s.wi * s.dist);
+            assert!(close(s.pdf, prob * d2 / cos, 1e-5), "cell ({x}, {z}): {} against {}", s.pdf, prob * d2 / cos);
+        }
+    }
+
+    #[test]
+    fn cell_counts_are_clamped_and_the_last_cell_catches_rounding() {
+        // From the origin with a receiver taking nothing, every cell has probability 1/k²
+        // and the density of uniform area sampling, ¼·d²/cos.
+        let mut g = Geometry::default();
+        g.add_mesh(quad(A, 3.0));
+        let pick = |cells: u32, u_choice: f32| {
+            let lights = AreaLights::new(&g, cells);
+            let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 0.0, LightSampling::Cells, u_choice, Vec2::splat(0.5)).unwrap();
+            let q = s.wi * s.dist;
+            assert!(close(s.pdf, 0.25 * q.length_squared() as f64 / s.wi.y as f64, 1e-5), "{cells} cells: {}", s.pdf);
+            q
+        };
+        // 0 cells means 1: the whole light, its centre.
+        assert!((pick(0, 0.2) - Vec3::Y).length() < 1e-5, "{}", pick(0, 0.2));
+        // 99 means 16: u_cell = 2·0.2 = 0.4 falls in cell ⌊0.4·256⌋ = 102 = (6, 6), centre
+        // st = 6.5/16 = 0.40625 on both edges: (−0.1875, 1, −0.1875).
+        assert!((pick(99, 0.2) - Vec3::new(-0.1875, 1.0, -0.1875)).length() < 1e-5, "{}", pick(99, 0.2));
+        // 7 × 7: the f32 sum of 49 sevenths-squared ends at 0.9999997, below the largest
+        // u_cell (1 − 2⁻²⁴, from u_choice just under ½): the last cell, (6, 6), centre
+        // st = 6.5/7, takes it.
+        let last = -1.0 + 2.0 * 6.5 / 7.0;
+        assert!((pick(7, 0.5 - f32::EPSILON / 4.0) - Vec3::new(last, 1.0, last)).length() < 1e-5, "{}", pick(7, 0.5 - f32::EPSILON / 4.0));
+    }
+
+    #[test]
     fn only_rectangles_are_sampled_by_solid_angle() {
         // A sheared parallelogram (a + c = b + d, e1·e2 = 1): no spherical rectangle, so its
         // solid-angle density is the area one, per triangle: (½)/2 · d²/cos = ¼·1.5^1.5 at
