@@ -699,6 +699,12 @@ mod tests {
         assert!(close(s.pdf, cap, 1e-4), "{} against {cap}", s.pdf);
         let q = p + s.wi * s.dist;
         assert!(close(lights.pdf(&g, LightSampling::SolidAngle, 0, p, q, (q - c).normalize()), cap, 1e-4));
+        // A sphere of radius ½ has area π: uniformly, its nearest point (0, 0, 1.5) has
+        // density d²/(area·cos) = 2.25/π.
+        let mut g_half = Geometry::default();
+        g_half.add_sphere(Sphere { center: c, radius: 0.5, to_world: Transform::IDENTITY, material: Default::default(), emission: Rgb::ONE });
+        let p = AreaLights::new(&g_half, 2).pdf(&g_half, LightSampling::Uniform, 0, Vec3::ZERO, Vec3::new(0.0, 0.0, 1.5), -Vec3::Z);
+        assert!(close(p, 2.25 / std::f64::consts::PI, 1e-5), "{p}");
         // From inside, the emitter's outside faces away: no sample.
         assert!(lights.sample(&g, &[], c + Vec3::new(0.1, 0.2, 0.0), &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(0.4, 0.7)).is_none());
     }
