@@ -592,6 +592,7 @@ mod tests {
             for strategy in [LightSampling::Uniform, LightSampling::SolidAngle, LightSampling::Cells] {
                 let s = lights.sample(&g, &textures, p, &|_| 1.0, strategy, u_choice, u).unwrap();
                 let q = p + s.wi * s.dist;
+                assert!((s.wi.length() - 1.0).abs() < 1e-5, "{strategy:?}: wi {} not unit", s.wi);
                 assert!((q.y - 1.0).abs() < 1e-5 && q.x.abs() <= 1.0 + 1e-5 && q.z.abs() <= 1.0 + 1e-5, "{strategy:?}: {q} off A");
                 let uv = Vec2::new((q.x + 1.0) / 2.0, (q.z + 1.0) / 2.0);
                 if (uv.x - 0.5).abs() < 1e-3 || (uv.y - 0.5).abs() < 1e-3 {
@@ -627,15 +628,16 @@ mod tests {
 
     #[test]
     fn quads_within_the_tolerances_are_sampled_as_rectangles() {
-        // A 4 × 4 light at height 1 facing down, centred above the origin: Ω = 4·asin(4/5)
-        // (half side 2, distance 1, a²/(a² + d²) = 4/5), solid-angle density 1/Ω against the
-        // area one, (½)/8 at the foot, if it were not taken for a rectangle.
-        // (i) c off by 2·10⁻⁵: a + c − (b + d) is within 10⁻⁵ of the longer edge (4·10⁻⁵);
-        // (ii) c and d shifted by 2·10⁻⁵ along x: a parallelogram with e1·e2 = 8·10⁻⁵, within
-        // 10⁻⁵·|e1|·|e2| = 1.6·10⁻⁴ of a right angle.
-        let omega = 4.0 * (0.8f64).asin();
-        let (a, b) = (Vec3::new(-2.0, 1.0, -2.0), Vec3::new(2.0, 1.0, -2.0));
-        for (c, d) in [(Vec3::new(2.0 + 2e-5, 1.0, 2.0), Vec3::new(-2.0, 1.0, 2.0)), (Vec3::new(2.0 + 2e-5, 1.0, 2.0), Vec3::new(-2.0 + 2e-5, 1.0, 2.0))] {
+        // A 4 × 2 light (e1 = b − a the longer edge) at height 1 facing down, centred above
+        // the origin: half sides 2 and 1 at distance 1 subtend Ω = 4·asin(2·1/√((4 + 1)(1 + 1)))
+        // = 4·asin(2/√10), solid-angle density 1/Ω against the area one, (½)/4 at the foot,
+        // if it were not taken for a rectangle.
+        // (i) c off by 3·10⁻⁵: a + c − (b + d) is within 10⁻⁵ of the longer edge (4·10⁻⁵);
+        // (ii) c and d shifted by 10⁻⁵ along x: a parallelogram with e1·e2 = 4·10⁻⁵, within
+        // 10⁻⁵·|e1|·|e2| = 8·10⁻⁵ of a right angle.
+        let omega = 4.0 * (2.0 / 10f64.sqrt()).asin();
+        let (a, b) = (Vec3::new(-2.0, 1.0, -1.0), Vec3::new(2.0, 1.0, -1.0));
+        for (c, d) in [(Vec3::new(2.0 + 3e-5, 1.0, 1.0), Vec3::new(-2.0, 1.0, 1.0)), (Vec3::new(2.0 + 1e-5, 1.0, 1.0), Vec3::new(-2.0 + 1e-5, 1.0, 1.0))] {
             let mut g = Geometry::default();
             g.add_mesh(quad([a, b, c, d], 1.0));
             let lights = AreaLights::new(&g, 2);
