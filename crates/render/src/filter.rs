@@ -77,6 +77,29 @@ mod tests {
     }
 
     #[test]
+    fn offsets_at_hand_worked_points() {
+        // Box: the offset is u − ½ on each axis.
+        assert_eq!(PixelFilter::Box.offset(Vec2::new(0.25, 0.9)), Vec2::new(-0.25, 0.9 - 0.5));
+        // Tent 1 − |x| on [−1, 1]: CDF (1 + x)²/2 left of 0, 1 − (1 − x)²/2 right of it, so
+        // u = 0.02 → −0.8, 0.125 → −0.5, ½ → 0, 0.875 → 0.5, 0.98 → 0.8; each axis on its own.
+        for (u, x) in [(0.02f32, -0.8f32), (0.125, -0.5), (0.5, 0.0), (0.875, 0.5), (0.98, 0.8), (0.0, -1.0)] {
+            let o = PixelFilter::Tent.offset(Vec2::new(u, 0.875));
+            assert!((o.x - x).abs() < 1e-6 && (o.y - 0.5).abs() < 1e-6, "tent({u}) = {o}");
+        }
+        // Gaussian σ = ½ truncated at ±1.5 = ±3σ: the CDF at x is (Φ(x/σ) − Φ(−3)) / (Φ(3) − Φ(−3)),
+        // with Φ(−3) = 0.0013498980, Φ(−2) = 0.0227501319, Φ(1) = 0.8413447461 (Abramowitz &
+        // Stegun 26.2): the offsets −1 (2σ), 0, ½ (1σ) and the ends.
+        let (lo, hi) = (0.001_349_898_0f64, 0.998_650_102_0f64);
+        let cdf = |phi: f64| ((phi - lo) / (hi - lo)) as f32;
+        for (u, x) in [(cdf(0.022_750_131_9), -1.0f32), (0.5, 0.0), (cdf(0.841_344_746_1), 0.5), (0.0, -1.5)] {
+            let o = PixelFilter::Gaussian.offset(Vec2::new(u, 1.0 - u));
+            assert!((o.x - x).abs() < 2e-4 && (o.y + x).abs() < 2e-4, "gaussian({u}) = {o}, expected ({x}, {})", -x);
+        }
+        let end = PixelFilter::Gaussian.offset(Vec2::splat(1.0 - f32::EPSILON / 2.0)).x;
+        assert!((end - 1.5).abs() < 1e-3, "{end}");
+    }
+
+    #[test]
     fn offsets_follow_the_filters() {
         // Box: uniform on [-½, ½], variance 1/12. Tent of radius 1: variance 1/6.
         let (m, v, r) = moments(PixelFilter::Box);

@@ -360,3 +360,373 @@ fn area(geometry: &Geometry, prim: u32) -> f32 {
         PrimRef::Curve { .. } | PrimRef::Patch { .. } => unreachable!("curves and patches do not emit light"),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    //! Hand-worked values for the area lights' choice, samples and densities, seen from the
+    //! origin: a 2 × 2 square light A at height 1 facing down (radiance 3, power 4·3 = 12)
+    //! and a 1 × 1 square light B at depth 2 facing up (radiance 2, power 2), after a
+    //! non-emitting triangle (prim 0): A is prims 1 and 2, B prims 3 and 4.
+    use super::*;
+    use crate::shape::{Sphere, TriangleMesh};
+    use raylab_core::Transform;
+
+    fn quad(corners: [Vec3; 4], le: f32) -> TriangleMesh {
+        TriangleMesh { name: "quad".into(), positions: corners.to_vec(), indices: vec![[0, 1, 2], [0, 2, 3]], emission: Rgb::splat(le), ..Default::default() }
+    }
+
+    /// Light A's corners: (b − a) × (c − a) = (2, 0, 0) × (2, 0, 2) = (0, −4, 0), facing down;
+    /// edges e1 = b − a along x, e2 = d − a along z.
+    const A: [Vec3; 4] = [Vec3::new(-1.0, 1.0, -1.0), Vec3::new(1.0, 1.0, -1.0), Vec3::new(1.0, 1.0, 1.0), Vec3::new(-1.0, 1.0, 1.0)];
+
+    fn scene() -> Geometry {
+        let mut g = Geometry::default();
+        g.add_mesh(TriangleMesh { name: "dark".into(), positions: vec![Vec3::new(5.0, 0.0, 0.0), Vec3::new(6.0, 0.0, 0.0), Vec3::new(5.0, 1.0, 0.0)], indices: vec![[0, 1, 2]], ..Default::default() });
+        g.add_mesh(quad(A, 3.0));
+        // (0, 0, 1) × (1, 0, 1) = (0, 1, 0): facing up, towards the origin.
+        g.add_mesh(quad([Vec3::new(2.0, -2.0, -0.5), Vec3::new(2.0, -2.0, 0.5), Vec3::new(3.0, -2.0, 0.5), Vec3::new(3.0, -2.0, -0.5)], 2.0));
+        g
+    }
+
+    fn close(a: f32, b: f64, rel: f64) -> bool {
+        (a as f64 - b).abs() <= rel * b.abs()
+    }
+
+    #[test]
+    fn emitters_are_chosen_by_power_and_densities_follow_by_hand() {
+        let g = scene();
+        let lights = AreaLights::new(&g, 4);
+        assert!(!lights.is_empty());
+        assert_eq!(lights.len(), 4);
+        let down = Vec3::new(0.0, -1.0, 0.0);
+        // Uniform: A's triangle 0 (half of A's 12/14, area 2) at q = (0.5, 1, −0.5):
+        // d² = 1.5, cos = 1/√1.5, so p = (6/14)/2 · d²/cos = (3/14)·1.5^1.5.
+        let q = Vec3::new(0.5, 1.0, -0.5);
+        let uniform = lights.pdf(&g, LightSampling::Uniform, 1, Vec3::ZERO, q, down);
+        assert!(close(uniform, 3.0 / 14.0 * 1.5f64.powf(1.5), 1e-5), "{uniform}");
+        // B's triangle at its nearest corner (2, −2, −0.5) with B's 2/14 over area 1:
+        // (1/14)/0.5 · d²/cos, d² = 8.25, cos = 2/√8.25.
+        let qb = Vec3::new(2.0, -2.0, -0.5);
+        let b = lights.pdf(&g, LightSampling::Uniform, 3, Vec3::ZERO, qb, Vec3::Y);
+        assert!(close(b, 1.0 / 7.0 * 8.25 * 8.25f64.sqrt() / 2.0, 1e-5), "{b}");
+        // Solid angle: A is a square of half side 1 at distance 1, Ω = 4·asin(1/2) = 2π/3, so
+        // p = (12/14)/(2π/3) = 9/(7π) for a direction towards either triangle.
+        for (strategy, prim) in [(LightSampling::SolidAngle, 1), (LightSampling::SolidAngle, 2), (LightSampling::Mis, 2), (LightSampling::Bsdf, 1)] {
+            let p = lights.pdf(&g, strategy, prim, Vec3::ZERO, q, down);
+            assert!(close(p, 9.0 / (7.0 * std::f64::consts::PI), 1e-5), "{strategy:?} {prim}: {p}");
+        }
+        // B by solid angle: x in [2, 3], z in [−0.5, 0.5] at distance 2, by inclusion and
+        // exclusion of atan(xz / (d·√(x² + z² + d²))) over the corners.
+        let f = |x: f64, z: f64| (x * z / (2.0 * (x * x + z * z + 4.0).sqrt())).atan();
+        let omega = f(3.0, 0.5) - f(2.0, 0.5) - f(3.0, -0.5) + f(2.0, -0.5);
+        let p = lights.pdf(&g, LightSampling::SolidAngle, 4, Vec3::ZERO, qb, Vec3::Y);
+        assert!(close(p, 2.0 / 14.0 / omega, 1e-4), "{p} against {}", 2.0 / 14.0 / omega);
+        // Not an emitter, out of range, or seen edge-on (n ⊥ q): no density.
+        assert_eq!(lights.pdf(&g, LightSampling::Uniform, 0, Vec3::ZERO, Vec3::new(5.0, 0.5, 0.0), Vec3::Z), 0.0);
+        assert_eq!(lights.pdf(&g, LightSampling::Uniform, 9, Vec3::ZERO, q, down), 0.0);
+        assert_eq!(lights.pdf(&g, LightSampling::Uniform, 1, Vec3::ZERO, q, Vec3::new(1.0, 0.0, 1.0)), 0.0);
+    }
+
+    #[test]
+    fn samples_pick_emitters_by_the_cdf_and_report_their_density() {
+        let g = scene();
+        let lights = AreaLights::new(&g, 4);
+        // The choice CDF over prims 1..=4 is 6/14, 12/14, 13/14, 1: u_choice 0.1 picks A's
+        // first triangle, 0.5 its second, 0.9 B's first, 0.99 B's second.
+        let u = Vec2::new(0.3, 0.6);
+        for (u_choice, light) in [(0.1f32, 'A'), (0.5, 'A'), (0.9, 'B'), (0.99, 'B')] {
+            let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 1.0, LightSampling::Uniform, u_choice, u).unwrap();
+            let q = s.wi * s.dist;
+            let (height, le, n) = if light == 'A' { (1.0, 3.0, -Vec3::Y) } else { (-2.0, 2.0, Vec3::Y) };
+            assert!((q.y - height).abs() < 1e-5, "{u_choice}: {q}");
+            assert_eq!(s.le, Rgb::splat(le));
+            // Area density (half the light's power share over half its area) to solid angle.
+            let share = if light == 'A' { 6.0 / 14.0 / 2.0 } else { 1.0 / 14.0 / 0.5 };
+            let expected = share * (s.dist as f64).powi(2) / n.dot(-s.wi) as f64;
+            assert!(close(s.pdf, expected, 1e-5), "{u_choice}: {} against {expected}", s.pdf);
+            // The same by solid angle: A's 12/14 over 2π/3.
+            let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 1.0, LightSampling::SolidAngle, u_choice, u).unwrap();
+            assert!((s.wi.length() - 1.0).abs() < 1e-5 && ((s.wi * s.dist).y - height).abs() < 1e-4, "{u_choice}: {} {}", s.wi, s.dist);
+            if light == 'A' {
+                assert!(close(s.pdf, 9.0 / (7.0 * std::f64::consts::PI), 1e-5), "{}", s.pdf);
+            }
+        }
+        // From above A (its back) nothing is lit, by any strategy.
+        for strategy in [LightSampling::Uniform, LightSampling::SolidAngle, LightSampling::Cells] {
+            assert!(lights.sample(&g, &[], Vec3::new(0.0, 2.0, 0.0), &|_| 1.0, strategy, 0.1, u).is_none(), "{strategy:?}");
+        }
+        assert!(LightSampling::Mis.samples_lights() && LightSampling::Uniform.samples_lights() && !LightSampling::Bsdf.samples_lights());
+    }
+
+    #[test]
+    fn cells_are_chosen_by_their_centres_light_with_a_uniform_share() {
+        // A alone, k = 2: cells in order (0, 0), (1, 0), (0, 1), (1, 1) along (e1, e2), centres
+        // (∓0.5, 1, ∓0.5). A receiver that takes light only from +x weighs cells 1 and 3
+        // equally (mirror images in z) and 0 and 2 not at all: probabilities 0.9·½ + 0.1/4 =
+        // 0.475 and 0.1/4 = 0.025, CDF 0.025, 0.5, 0.525, 1. The cell's point has area density
+        // prob·4 cells / area 4, in solid angle prob·d²/cos = prob·1.5^1.5 at a cell's centre.
+        let mut g = Geometry::default();
+        g.add_mesh(quad(A, 3.0));
+        let lights = AreaLights::new(&g, 2);
+        let receiver = |w: Vec3| w.x.max(0.0);
+        let centre = Vec2::splat(0.5);
+        // u_choice in A's first triangle (CDF 0.5) is stretched to 2·u_choice, in the second
+        // to 2·(u_choice − 0.5).
+        for (u_choice, cell, prob) in [(0.005f32, Vec3::new(-0.5, 1.0, -0.5), 0.025), (0.2, Vec3::new(0.5, 1.0, -0.5), 0.475), (0.6, Vec3::new(0.5, 1.0, -0.5), 0.475), (0.26, Vec3::new(-0.5, 1.0, 0.5), 0.025), (0.9, Vec3::new(0.5, 1.0, 0.5), 0.475)] {
+            let s = lights.sample(&g, &[], Vec3::ZERO, &receiver, LightSampling::Cells, u_choice, centre).unwrap();
+            assert!((s.wi * s.dist - cell).length() < 1e-5, "{u_choice}: {} against {cell}", s.wi * s.dist);
+            assert!(close(s.pdf, prob * 1.5f64.powf(1.5), 1e-5), "{u_choice}: {} against {}", s.pdf, prob * 1.5f64.powf(1.5));
+            assert_eq!(s.le, Rgb::splat(3.0));
+        }
+        // A point inside a cell: cell (1, 1) at offset (0.25, 0.75) is st = (0.625, 0.875),
+        // (−1 + 1.25, 1, −1 + 1.75).
+        let s = lights.sample(&g, &[], Vec3::ZERO, &receiver, LightSampling::Cells, 0.9, Vec2::new(0.25, 0.75)).unwrap();
+        assert!((s.wi * s.dist - Vec3::new(0.25, 1.0, 0.75)).length() < 1e-5, "{}", s.wi * s.dist);
+        // A receiver that takes no light: every cell 1/4, the density of uniform area sampling.
+        let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 0.0, LightSampling::Cells, 0.2, centre).unwrap();
+        assert!(close(s.pdf, 0.25 * 1.5f64.powf(1.5), 1e-5), "{}", s.pdf);
+    }
+
+    #[test]
+    fn cell_weights_follow_the_documented_importance_from_off_centre() {
+        // From p = (0.3, 0, −0.6) the four cells' centres c lie at different distances: the
+        // weight is receiver(ω)·(n·−ω)/d²·lum(Le) (n = −y, so n·−ω = ω.y), with a receiver
+        // 0.1 + max(0, ω.x) + 2·max(0, ω.z) (an offset, so that scaling ω would show), and the
+        // probability 0.9·w/Σw + 0.1/4. Each cell's centre (u = ½) must come out with density
+        // prob·(4 cells / area 4)·d²/(n·−ω).
+        let mut g = Geometry::default();
+        g.add_mesh(quad(A, 3.0));
+        let lights = AreaLights::new(&g, 2);
+        let p = Vec3::new(0.3, 0.0, -0.6);
+        let receiver = |w: Vec3| 0.1 + w.x.max(0.0) + 2.0 * w.z.max(0.0);
+        let centres = [(-0.5f64, -0.5f64), (0.5, -0.5), (-0.5, 0.5), (0.5, 0.5)];
+        let geo = |(x, z): (f64, f64)| {
+            let d = (x - 0.3, 1.0, z + 0.6);
+            let d2 = d.0 * d.0 + d.1 * d.1 + d.2 * d.2;
+            let w = (d.0 / d2.sqrt(), d.1 / d2.sqrt(), d.2 / d2.sqrt());
+            (d2, w.1, (0.1 + w.0.max(0.0) + 2.0 * w.2.max(0.0)) * w.1 / d2 * 3.0)
+        };
+        let total: f64 = centres.iter().map(|&c| geo(c).2).sum();
+        let mut lo = 0.0;
+        for &(x, z) in &centres {
+            let (d2, cos, w) = geo((x, z));
+            let prob = 0.9 * w / total + 0.025;
+            // The middle of the cell's CDF interval, as u_choice in A's first triangle (×2).
+            let u_choice = ((lo + prob / 2.0) / 2.0) as f32;
+            lo += prob;
+            let s = lights.sample(&g, &[], p, &receiver, LightSampling::Cells, u_choice, Vec2::splat(0.5)).unwrap();
+            assert!((p + s.wi * s.dist - Vec3::new(x as f32, 1.0, z as f32)).length() < 1e-5, "cell ({x}, {z}): {}", p + s.wi * s.dist);
+            assert!(close(s.pdf, prob * d2 / cos, 1e-5), "cell ({x}, {z}): {} against {}", s.pdf, prob * d2 / cos);
+        }
+    }
+
+    #[test]
+    fn cell_counts_are_clamped_and_the_last_cell_catches_rounding() {
+        // From the origin with a receiver taking nothing, every cell has probability 1/k²
+        // and the density of uniform area sampling, ¼·d²/cos.
+        let mut g = Geometry::default();
+        g.add_mesh(quad(A, 3.0));
+        let pick = |cells: u32, u_choice: f32| {
+            let lights = AreaLights::new(&g, cells);
+            let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 0.0, LightSampling::Cells, u_choice, Vec2::splat(0.5)).unwrap();
+            let q = s.wi * s.dist;
+            assert!(close(s.pdf, 0.25 * q.length_squared() as f64 / s.wi.y as f64, 1e-5), "{cells} cells: {}", s.pdf);
+            q
+        };
+        // 0 cells means 1: the whole light, its centre.
+        assert!((pick(0, 0.2) - Vec3::Y).length() < 1e-5, "{}", pick(0, 0.2));
+        // 99 means 16: u_cell = 2·0.2 = 0.4 falls in cell ⌊0.4·256⌋ = 102 = (6, 6), centre
+        // st = 6.5/16 = 0.40625 on both edges: (−0.1875, 1, −0.1875).
+        assert!((pick(99, 0.2) - Vec3::new(-0.1875, 1.0, -0.1875)).length() < 1e-5, "{}", pick(99, 0.2));
+        // 7 × 7: the f32 sum of 49 sevenths-squared ends at 0.9999997, below the largest
+        // u_cell (1 − 2⁻²⁴, from u_choice just under ½): the last cell, (6, 6), centre
+        // st = 6.5/7, takes it.
+        let last = -1.0 + 2.0 * 6.5 / 7.0;
+        assert!((pick(7, 0.5 - f32::EPSILON / 4.0) - Vec3::new(last, 1.0, last)).length() < 1e-5, "{}", pick(7, 0.5 - f32::EPSILON / 4.0));
+    }
+
+    #[test]
+    fn only_rectangles_are_sampled_by_solid_angle() {
+        // A sheared parallelogram (a + c = b + d, e1·e2 = 1): no spherical rectangle, so its
+        // solid-angle density is the area one, per triangle: (½)/2 · d²/cos = ¼·1.5^1.5 at
+        // (0.5, 1, −0.5) (area 4, each triangle 2, half the choice each).
+        let mut g = Geometry::default();
+        g.add_mesh(quad([Vec3::new(-1.0, 1.0, -1.0), Vec3::new(1.0, 1.0, -1.0), Vec3::new(1.5, 1.0, 1.0), Vec3::new(-0.5, 1.0, 1.0)], 1.0));
+        let lights = AreaLights::new(&g, 2);
+        let p = lights.pdf(&g, LightSampling::SolidAngle, 0, Vec3::ZERO, Vec3::new(0.5, 1.0, -0.5), -Vec3::Y);
+        assert!(close(p, 0.25 * 1.5f64.powf(1.5), 1e-5), "{p}");
+        // Its cells still work: four equal cells from a receiver taking nothing, 1/4 each, at
+        // cell (1, 0)'s centre st = (0.75, 0.25): a + 0.75·e1 + 0.25·e2 = (0.625, 1, −0.5).
+        let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 0.0, LightSampling::Cells, 0.2, Vec2::splat(0.5)).unwrap();
+        let q = Vec3::new(0.625, 1.0, -0.5);
+        assert!((s.wi * s.dist - q).length() < 1e-5, "{}", s.wi * s.dist);
+        assert!(close(s.pdf, 0.25 * q.length_squared() as f64 / (1.0 / q.length() as f64), 1e-5), "{}", s.pdf);
+        // A quadrilateral that is no parallelogram (d moved): each triangle on its own, even
+        // with the cells strategy: triangle 0 (a, b, c) has area 2, half the power of 2 + 2.5.
+        let mut g = Geometry::default();
+        g.add_mesh(quad([Vec3::new(-1.0, 1.0, -1.0), Vec3::new(1.0, 1.0, -1.0), Vec3::new(1.0, 1.0, 1.0), Vec3::new(-1.5, 1.0, 1.0)], 1.0));
+        let lights = AreaLights::new(&g, 2);
+        for strategy in [LightSampling::SolidAngle, LightSampling::Cells] {
+            let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 1.0, strategy, 0.1, Vec2::new(0.3, 0.6)).unwrap();
+            let expected = (2.0 / 4.5) / 2.0 * (s.dist as f64).powi(2) / s.wi.y as f64;
+            assert!(close(s.pdf, expected, 1e-5), "{strategy:?}: {} against {expected}", s.pdf);
+        }
+    }
+
+    #[test]
+    fn textured_emission_is_read_where_the_sample_lands() {
+        // A with UVs (0, 0), (1, 0), (1, 1), (0, 1) at a, b, c, d (so uv = ((x + 1)/2, (z + 1)/2)
+        // on it) and a 2 × 2 nearest-texel emission texture: row 0 (v > ½) red, green; row 1
+        // blue, white. Seen from off the axis, every strategy's sample must carry the texel
+        // under its own point (2 × the texel), and lie on A at the distance it reports.
+        let mut g = Geometry::default();
+        g.add_mesh(TriangleMesh { uvs: vec![Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y], emission_texture: Some(crate::material::TextureId(0)), ..quad(A, 2.0) });
+        let texels = vec![Rgb::X, Rgb::Y, Rgb::Z, Rgb::ONE];
+        let textures = [Texture::Image(crate::texture::ImageTexture::new(2, 2, texels.clone(), crate::texture::Wrap::Clamp, crate::texture::Filter::Nearest).unwrap())];
+        let lights = AreaLights::new(&g, 2);
+        let p = Vec3::new(0.3, -0.5, 0.2);
+        let mut rng = raylab_core::Pcg32::new(7, 2);
+        let mut seen = [0; 4];
+        for _ in 0..200 {
+            let (u_choice, u) = (rng.next_f32(), rng.next_vec2());
+            for strategy in [LightSampling::Uniform, LightSampling::SolidAngle, LightSampling::Cells] {
+                let s = lights.sample(&g, &textures, p, &|_| 1.0, strategy, u_choice, u).unwrap();
+                let q = p + s.wi * s.dist;
+                assert!((s.wi.length() - 1.0).abs() < 1e-5, "{strategy:?}: wi {} not unit", s.wi);
+                assert!((q.y - 1.0).abs() < 1e-5 && q.x.abs() <= 1.0 + 1e-5 && q.z.abs() <= 1.0 + 1e-5, "{strategy:?}: {q} off A");
+                let uv = Vec2::new((q.x + 1.0) / 2.0, (q.z + 1.0) / 2.0);
+                if (uv.x - 0.5).abs() < 1e-3 || (uv.y - 0.5).abs() < 1e-3 {
+                    continue;
+                }
+                if strategy == LightSampling::Uniform {
+                    // Half the choice over half the area 4, turned to solid angle from p; the
+                    // same from `pdf` for either triangle.
+                    let expected = 0.25 * (s.dist as f64).powi(2) / s.wi.y as f64;
+                    assert!(close(s.pdf, expected, 1e-4), "{} against {expected}", s.pdf);
+                    assert!(close(lights.pdf(&g, strategy, 0, p, q, -Vec3::Y), expected, 1e-4), "pdf at {q}");
+                }
+                let texel = (uv.x >= 0.5) as usize + 2 * (uv.y < 0.5) as usize;
+                seen[texel] += 1;
+                assert_eq!(s.le, texels[texel] * 2.0, "{strategy:?}: at uv {uv}");
+            }
+        }
+        assert!(seen.iter().all(|&n| n > 50), "{seen:?}");
+    }
+
+    #[test]
+    fn a_mesh_is_a_parallelogram_only_with_both_triangles() {
+        // A's four corners but only the triangle (a, b, c) (d unused), and B after it: no
+        // parallelogram, so the triangle's solid-angle density is its area one, the whole
+        // choice over area 2: ½·d²/cos at (0.5, 1, −0.5), ½·1.5^1.5 (not 1/Ω of the square).
+        let mut g = Geometry::default();
+        g.add_mesh(TriangleMesh { indices: vec![[0, 1, 2]], ..quad(A, 3.0) });
+        g.add_mesh(quad([Vec3::new(2.0, -2.0, -0.5), Vec3::new(2.0, -2.0, 0.5), Vec3::new(3.0, -2.0, 0.5), Vec3::new(3.0, -2.0, -0.5)], 0.0));
+        let lights = AreaLights::new(&g, 2);
+        let p = lights.pdf(&g, LightSampling::SolidAngle, 0, Vec3::ZERO, Vec3::new(0.5, 1.0, -0.5), -Vec3::Y);
+        assert!(close(p, 0.5 * 1.5f64.powf(1.5), 1e-5), "{p}");
+    }
+
+    #[test]
+    fn quads_within_the_tolerances_are_sampled_as_rectangles() {
+        // A 4 × 2 light (e1 = b − a the longer edge) at height 1 facing down, centred above
+        // the origin: half sides 2 and 1 at distance 1 subtend Ω = 4·asin(2·1/√((4 + 1)(1 + 1)))
+        // = 4·asin(2/√10), solid-angle density 1/Ω against the area one, (½)/4 at the foot,
+        // if it were not taken for a rectangle.
+        // (i) c off by 3·10⁻⁵: a + c − (b + d) is within 10⁻⁵ of the longer edge (4·10⁻⁵);
+        // (ii) c and d shifted by 10⁻⁵ along x: a parallelogram with e1·e2 = 4·10⁻⁵, within
+        // 10⁻⁵·|e1|·|e2| = 8·10⁻⁵ of a right angle.
+        let omega = 4.0 * (2.0 / 10f64.sqrt()).asin();
+        let (a, b) = (Vec3::new(-2.0, 1.0, -1.0), Vec3::new(2.0, 1.0, -1.0));
+        for (c, d) in [(Vec3::new(2.0 + 3e-5, 1.0, 1.0), Vec3::new(-2.0, 1.0, 1.0)), (Vec3::new(2.0 + 1e-5, 1.0, 1.0), Vec3::new(-2.0 + 1e-5, 1.0, 1.0))] {
+            let mut g = Geometry::default();
+            g.add_mesh(quad([a, b, c, d], 1.0));
+            let lights = AreaLights::new(&g, 2);
+            let p = lights.pdf(&g, LightSampling::SolidAngle, 0, Vec3::ZERO, Vec3::new(0.0, 1.0, 0.0), -Vec3::Y);
+            assert!(close(p, 1.0 / omega, 1e-4), "c {c}, d {d}: {p} against {}", 1.0 / omega);
+        }
+    }
+
+    #[test]
+    fn sphere_lights_are_sampled_uniformly_in_their_cone() {
+        // Radius 1 at distance 2: sin²θmax = 1/4, cos θmax = √3/2, the cap's solid angle
+        // 2π(1 − √3/2). u.x = 0 is the axis (the nearest point, at distance 1), u.x → 1 the
+        // silhouette (tangent, at distance √(4 − 1)), and cos θ = 1 − u.x(1 − cos θmax) between,
+        // hitting the sphere at 2cos θ − √(1 − 4 sin²θ).
+        let mut g = Geometry::default();
+        let c = Vec3::new(0.0, 0.0, 2.0);
+        g.add_sphere(Sphere { center: c, radius: 1.0, to_world: Transform::IDENTITY, material: Default::default(), emission: Rgb::splat(5.0) });
+        let lights = AreaLights::new(&g, 2);
+        let cos_max = 3f64.sqrt() / 2.0;
+        let cap = 1.0 / (2.0 * std::f64::consts::PI * (1.0 - cos_max));
+        for (ux, uy) in [(0.0f32, 0.3f32), (0.5, 0.3), (0.5, 0.8), (0.9, 0.1), (1.0 - f32::EPSILON / 2.0, 0.6)] {
+            let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(ux, uy)).unwrap();
+            let cos = 1.0 - ux as f64 * (1.0 - cos_max);
+            let sin2 = 1.0 - cos * cos;
+            assert!(close(s.wi.z, cos, 1e-5), "{ux}: wi {}", s.wi);
+            assert!(close(s.dist, 2.0 * cos - (1.0 - 4.0 * sin2).max(0.0).sqrt(), 2e-3), "{ux}: dist {}", s.dist);
+            assert!(((s.wi * s.dist - c).length() - 1.0).abs() < 1e-4, "{ux}: off the sphere");
+            assert!(close(s.pdf, cap, 1e-5), "{ux}: {}", s.pdf);
+            assert_eq!(s.le, Rgb::splat(5.0));
+        }
+        // u.y turns the direction about the axis: half a turn apart, mirror images.
+        let at = |uy: f32| lights.sample(&g, &[], Vec3::ZERO, &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(0.5, uy)).unwrap().wi;
+        let (w0, w1) = (at(0.1), at(0.6));
+        assert!((w0.x + w1.x).abs() < 1e-5 && (w0.y + w1.y).abs() < 1e-5 && (w0.z - w1.z).abs() < 1e-6, "{w0} {w1}");
+        assert!((at(0.35).x - w0.y).abs() < 1e-5 || (at(0.35).x + w0.y).abs() < 1e-5, "a quarter turn: {} {w0}", at(0.35));
+        // The density for a direction found otherwise is the cap's too; uniform sampling of
+        // the whole sphere (area 4π) gives the nearest point 1/(4π)·d²/cos = 1/(4π).
+        let near = Vec3::new(0.0, 0.0, 1.0);
+        assert!(close(lights.pdf(&g, LightSampling::SolidAngle, 0, Vec3::ZERO, near, -Vec3::Z), cap, 1e-5));
+        let p = lights.pdf(&g, LightSampling::Uniform, 0, Vec3::ZERO, near, -Vec3::Z);
+        assert!(close(p, 1.0 / (4.0 * std::f64::consts::PI), 1e-5), "{p}");
+        // Uniform sampling takes points all over the sphere (the far side refused, facing
+        // away), at the area density 1/(4π)·d²/cos turned to solid angle, not the cap's.
+        let mut rng = raylab_core::Pcg32::new(3, 4);
+        let mut lit = 0;
+        for _ in 0..256 {
+            if let Some(s) = lights.sample(&g, &[], Vec3::ZERO, &|_| 1.0, LightSampling::Uniform, 0.5, rng.next_vec2()) {
+                let n = (s.wi * s.dist - c).normalize();
+                let expected = (s.dist as f64).powi(2) / (4.0 * std::f64::consts::PI * n.dot(-s.wi) as f64);
+                assert!(close(s.pdf, expected, 1e-4), "{} against {expected}", s.pdf);
+                lit += 1;
+            }
+        }
+        // The near side, (1 − r/d)/2 = ¼ of the sphere, takes about 64 of 256.
+        assert!((32..128).contains(&lit), "{lit} of 256 on the near side");
+        // Outside but within √2 of the centre (r² = 1 < d² = 1.44 < 2r): still the cone, with
+        // sin²θmax = 1/1.44.
+        let p = c - Vec3::new(0.0, 0.0, 1.2);
+        let s = lights.sample(&g, &[], p, &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(0.3, 0.3)).unwrap();
+        let cap = 1.0 / (2.0 * std::f64::consts::PI * (1.0 - (1.0 - 1.0 / 1.44f64).sqrt()));
+        assert!(close(s.pdf, cap, 1e-4), "{} against {cap}", s.pdf);
+        let q = p + s.wi * s.dist;
+        assert!(close(lights.pdf(&g, LightSampling::SolidAngle, 0, p, q, (q - c).normalize()), cap, 1e-4));
+        // A sphere of radius ½ has area π: uniformly, its nearest point (0, 0, 1.5) has
+        // density d²/(area·cos) = 2.25/π.
+        let mut g_half = Geometry::default();
+        g_half.add_sphere(Sphere { center: c, radius: 0.5, to_world: Transform::IDENTITY, material: Default::default(), emission: Rgb::ONE });
+        let p = AreaLights::new(&g_half, 2).pdf(&g_half, LightSampling::Uniform, 0, Vec3::ZERO, Vec3::new(0.0, 0.0, 1.5), -Vec3::Z);
+        assert!(close(p, 2.25 / std::f64::consts::PI, 1e-5), "{p}");
+        // From inside, the emitter's outside faces away: no sample.
+        assert!(lights.sample(&g, &[], c + Vec3::new(0.1, 0.2, 0.0), &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(0.4, 0.7)).is_none());
+    }
+
+    #[test]
+    fn tiny_sphere_caps_use_the_small_angle_expansion() {
+        // Radius 0.01 at distance 1: sin²θmax = 10⁻⁴, 1 − cos θmax = sin²θmax/2 + O(sin⁴) =
+        // 5·10⁻⁵ (to 2.5·10⁻⁵ relative; computed as 1 − cos in f32 it would lose ~10⁻³), so the
+        // density is 1/(2π·5·10⁻⁵), and sin²θ = 10⁻⁴·u.x.
+        let mut g = Geometry::default();
+        g.add_sphere(Sphere { center: Vec3::new(0.0, 1.0, 0.0), radius: 0.01, to_world: Transform::IDENTITY, material: Default::default(), emission: Rgb::ONE });
+        let lights = AreaLights::new(&g, 2);
+        let expected = 1.0 / (2.0 * std::f64::consts::PI * 5e-5);
+        for ux in [0.25f32, 0.5, 0.9] {
+            let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(ux, 0.2)).unwrap();
+            assert!(close(s.pdf, expected, 1e-4), "{}", s.pdf);
+            let sin2 = s.wi.cross(Vec3::Y).length_squared();
+            assert!(close(sin2, 1e-4 * ux as f64, 2e-3), "{ux}: sin² {sin2}");
+        }
+        let p = lights.pdf(&g, LightSampling::Mis, 0, Vec3::ZERO, Vec3::new(0.0, 0.99, 0.0), -Vec3::Y);
+        assert!(close(p, expected, 1e-4), "{p}");
+    }
+}

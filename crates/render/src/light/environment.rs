@@ -160,6 +160,100 @@ mod tests {
         assert!(v_is * 20.0 < v_u, "variance IS {v_is}, uniform {v_u}");
     }
 
+    /// A 4 × 2 grey map, nearest-texel lookups (so each texel's 16 weight lookups return the
+    /// texel itself), luminances [1, 2, 3, 4] in the top row (latitudes 0 to 90° north) and
+    /// [0, 0, 0, 2] in the bottom one, scaled by (2, 1, 0.5).
+    fn tiny_map() -> EnvironmentLight {
+        let texels = [1.0, 2.0, 3.0, 4.0, 0.0, 0.0, 0.0, 2.0].map(Rgb::splat).to_vec();
+        EnvironmentLight::new(ImageTexture::new(4, 2, texels, Wrap::Repeat, Filter::Nearest).unwrap(), Rgb::new(2.0, 1.0, 0.5))
+    }
+
+    /// The direction at longitude fraction `s` (u) and latitude `lat` (radians north): the
+    /// equirectangular map has φ = 2π(s − ½) from +x towards +z, +y up.
+    fn dir(s: f32, lat: f32) -> Vec3 {
+        let phi = 2.0 * PI * (s - 0.5);
+        Vec3::new(lat.cos() * phi.cos(), lat.sin(), lat.cos() * phi.sin())
+    }
+
+    #[test]
+    fn tiny_map_densities_and_radiance_by_hand() {
+        // Both rows' centres lie at ±45°, so the cos λ weights are equal and the texel density
+        // over the image square is luminance / mean luminance = L / (12/8) = L / 1.5 (the scale
+        // multiplies every weight by the same luminance(2, 1, 0.5) and cancels). In solid angle
+        // p(ω) = p(s, t) / (2π² cos λ) at the direction's own latitude λ.
+        let env = tiny_map();
+        let scale = Rgb::new(2.0, 1.0, 0.5);
+        let pi2 = PI * PI;
+        let cases = [
+            // (s, λ, texel luminance): texel (3, 0) at its centre, (1, 0) at 60°, (3, 1) at −30°,
+            // (0, 1) (black) at −45°.
+            (0.875, PI / 4.0, 4.0),
+            (0.375, PI / 3.0, 2.0),
+            (0.875, -PI / 6.0, 2.0),
+            (0.125, -PI / 4.0, 0.0),
+        ];
+        for (s, lat, l) in cases {
+            let w = dir(s, lat);
+            let expected = l / 1.5 / (2.0 * pi2 * lat.cos());
+            assert!((env.pdf(w) - expected).abs() <= 1e-5 * expected.max(1e-3), "s {s}, λ {lat}: {} against {expected}", env.pdf(w));
+            assert!((env.radiance(w) - scale * l).abs().max_element() < 1e-5, "s {s}, λ {lat}: {}", env.radiance(w));
+        }
+        // The centre of texel (3, 0) worked out: φ = 3π/4, λ = π/4, p = (8/3) / (√2·π²).
+        let w = Vec3::new(-0.5, std::f32::consts::FRAC_1_SQRT_2, 0.5);
+        assert!((env.pdf(w) - 8.0 / 3.0 / (2f32.sqrt() * pi2)).abs() < 1e-6, "{}", env.pdf(w));
+        // At the poles the rows' solid angle vanishes: no density, and a sample that lands on
+        // the north pole (u.y = 0 is the top of row 0, t = 0) is refused.
+        assert_eq!(env.pdf(Vec3::Y), 0.0);
+        assert_eq!(env.pdf(-Vec3::Y), 0.0);
+        assert!(env.sample(Vec2::new(0.3, 0.0)).is_none());
+    }
+
+    #[test]
+    fn tiny_map_samples_texels_in_proportion_to_luminance() {
+        // A regular 120 × 120 grid of u through the inverse CDFs: row 0 takes 10/12 of u.y
+        // (100 of 120 rows), and within it texel x takes (x + 1)/10 of u.x; row 1 takes 20 rows
+        // and all of them texel 3. Every sample reports the radiance and the density of the
+        // texel its direction lies in, by hand as above.
+        let env = tiny_map();
+        let lum = [[1.0f32, 2.0, 3.0, 4.0], [0.0, 0.0, 0.0, 2.0]];
+        let mut counts = [[0u32; 4]; 2];
+        let n = 120;
+        for (i, j) in (0..n * n).map(|k| (k % n, k / n)) {
+            let u = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+            let smp = env.sample(u).unwrap();
+            let w = smp.wi;
+            assert!((w.length() - 1.0).abs() < 1e-5, "{w}");
+            let s = 0.5 + w.z.atan2(w.x) / (2.0 * PI);
+            let lat = w.y.clamp(-1.0, 1.0).asin();
+            let (x, y) = (((s * 4.0) as usize).min(3), if lat > 0.0 { 0 } else { 1 });
+            counts[y][x] += 1;
+            let l = lum[y][x];
+            assert!(l > 0.0, "u {u}: sampled the black texel ({x}, {y})");
+            assert!((smp.le - Rgb::new(2.0, 1.0, 0.5) * l).abs().max_element() < 1e-5, "u {u}: {}", smp.le);
+            let expected = l / 1.5 / (2.0 * PI * PI * lat.cos());
+            assert!((smp.pdf - expected).abs() <= 1e-4 * expected, "u {u}: pdf {} against {expected}", smp.pdf);
+        }
+        let expected = [[1200u32, 2400, 3600, 4800], [0, 0, 0, 2400]];
+        for (y, (got, want)) in counts.iter().zip(&expected).enumerate() {
+            for (x, (&c, &e)) in got.iter().zip(want).enumerate() {
+                assert!(c.abs_diff(e) <= 2 * n as u32, "texel ({x}, {y}): {c} against {e}");
+            }
+        }
+    }
+
+    #[test]
+    fn check_image_rejects_negative_texels_only() {
+        let image = |bad: Rgb| ImageTexture::new(3, 2, vec![Rgb::ONE, Rgb::ONE, Rgb::ONE, Rgb::ONE, bad, Rgb::ONE], Wrap::Repeat, Filter::Bilinear).unwrap();
+        // Zero (and −0) radiance is fine; texel 4 of a 3-wide image is (1, 1).
+        assert_eq!(EnvironmentLight::check_image(&image(Rgb::ZERO)), Ok(()));
+        assert_eq!(EnvironmentLight::check_image(&image(Rgb::new(-0.0, 0.0, 5.0))), Ok(()));
+        // (`ImageTexture::new` itself refuses non-finite texels.)
+        for bad in [Rgb::new(1.0, -1e-3, 1.0), Rgb::new(1.0, 1.0, -5.0)] {
+            let err = EnvironmentLight::check_image(&image(bad)).unwrap_err();
+            assert!(err.starts_with("texel (1, 1) is ["), "{bad}: {err}");
+        }
+    }
+
     #[test]
     fn black_map_samples_nothing() {
         let black = ImageTexture::new(4, 2, vec![Rgb::ZERO; 8], Wrap::Repeat, Filter::Bilinear).unwrap();

@@ -135,6 +135,70 @@ mod tests {
     }
 
     #[test]
+    fn light_kinds_report_their_names_counts_and_jitter() {
+        let grid = Light::Grid { corner: Vec3::ZERO, edge_u: Vec3::X, edge_v: Vec3::Z, n: 3, intensity: Rgb::ONE };
+        let point = Light::Point { position: Vec3::ZERO, intensity: Rgb::ONE };
+        let sun = Light::Directional { direction: -Vec3::Y, irradiance: Rgb::ONE };
+        let ambient = Light::Ambient { intensity: Rgb::ONE };
+        let spot = Light::Spot { position: Vec3::ZERO, direction: -Vec3::Y, intensity: Rgb::ONE, cos_inner: 0.9, cos_outer: 0.5 };
+        let names: Vec<_> = [&point, &sun, &ambient, &grid, &spot].iter().map(|l| l.type_name()).collect();
+        assert_eq!(names, ["point", "directional", "ambient", "grid", "spot"]);
+        // A 3 × 3 grid takes 9 jittered samples (n² and not 2n: they agree at n = 2); the
+        // others one, unjittered.
+        assert_eq!(grid.sample_count(), 9);
+        assert!(grid.is_jittered());
+        for l in [&point, &sun, &ambient, &spot] {
+            assert_eq!(l.sample_count(), 1, "{}", l.type_name());
+            assert!(!l.is_jittered(), "{}", l.type_name());
+        }
+        assert!(ambient.sample(Vec3::X, 0, Vec2::ZERO).is_none());
+    }
+
+    #[test]
+    fn directional_light_arrives_against_its_direction_from_infinitely_far() {
+        let l = Light::Directional { direction: Vec3::new(0.0, -0.6, 0.8), irradiance: Rgb::new(1.0, 2.0, 3.0) };
+        let s = l.sample(Vec3::new(5.0, -7.0, 1.0), 0, Vec2::splat(0.3)).unwrap();
+        assert_eq!(s.wi, Vec3::new(0.0, 0.6, -0.8));
+        assert_eq!(s.dist, f32::INFINITY);
+        assert_eq!(s.irradiance, Rgb::new(1.0, 2.0, 3.0));
+    }
+
+    #[test]
+    fn grid_cell_positions_and_shares_on_a_three_by_three_grid() {
+        // Corner (1, 2, 3), edges (3, 0, 0) and (0, 0, 1.5), n = 3: sample k = 5 is cell
+        // (k mod 3, k div 3) = (2, 1), and jitter (0.25, 0.75) puts it at fractions
+        // ((2 + 0.25)/3, (1 + 0.75)/3) = (0.75, 7/12) of the edges: (1 + 2.25, 2, 3 + 0.875).
+        // Seen from 3 below, it carries 36/9 = 4 at distance 3: irradiance 4/9.
+        let l = Light::Grid { corner: Vec3::new(1.0, 2.0, 3.0), edge_u: Vec3::new(3.0, 0.0, 0.0), edge_v: Vec3::new(0.0, 0.0, 1.5), n: 3, intensity: Rgb::splat(36.0) };
+        let s = l.sample(Vec3::new(3.25, -1.0, 3.875), 5, Vec2::new(0.25, 0.75)).unwrap();
+        assert!((s.wi - Vec3::Y).length() < 1e-6, "{}", s.wi);
+        assert!((s.dist - 3.0).abs() < 1e-6, "{}", s.dist);
+        assert!((s.irradiance - Rgb::splat(4.0 / 9.0)).abs().max_element() < 1e-6, "{}", s.irradiance);
+    }
+
+    #[test]
+    fn spot_falloff_by_hand() {
+        // cos_inner 0.9, cos_outer 0.5: at cos 0.8, t = (0.8 − 0.5)/(0.9 − 0.5) = 0.75, t² = 0.5625;
+        // clamped to 1 inside the inner cone and to 0 outside the outer one.
+        assert!((spot_falloff(0.8, 0.9, 0.5) - 0.5625).abs() < 1e-6, "{}", spot_falloff(0.8, 0.9, 0.5));
+        assert_eq!(spot_falloff(0.95, 0.9, 0.5), 1.0);
+        assert_eq!(spot_falloff(0.3, 0.9, 0.5), 0.0);
+        // Equal cones: the ramp's width is floored at 10⁻³, so 0.0005 past the edge is
+        // halfway, 0.25.
+        assert!((spot_falloff(0.5005, 0.5, 0.5) - 0.25).abs() < 1e-3, "{}", spot_falloff(0.5005, 0.5, 0.5));
+        // Exactly on the outer cone the falloff is 0, and the spot gives no sample there: the
+        // point (0, −3, 4) is at distance 5 with cos 3/5 from the axis, which f32 computes
+        // exactly as the literal 0.6.
+        let l = Light::Spot { position: Vec3::ZERO, direction: -Vec3::Y, intensity: Rgb::ONE, cos_inner: 0.9, cos_outer: 0.6 };
+        assert!(l.sample(Vec3::new(0.0, -3.0, 4.0), 0, Vec2::ZERO).is_none());
+        let inside = l.sample(Vec3::new(0.0, -3.0, 3.9), 0, Vec2::ZERO).unwrap();
+        assert!(inside.irradiance.x > 0.0);
+        // Straight down the axis at distance 2: the full intensity over d² = 4, wi back up.
+        let s = l.sample(Vec3::new(0.0, -2.0, 0.0), 0, Vec2::ZERO).unwrap();
+        assert_eq!((s.wi, s.dist, s.irradiance), (Vec3::Y, 2.0, Rgb::splat(0.25)));
+    }
+
+    #[test]
     fn grid_light_splits_its_intensity_over_jittered_cells() {
         // A 2×2 grid over [0,2]×[0,2] at height 1: cell k with jitter u lies at
         // ((k % 2 + u.x), 1, (k / 2 + u.y)), and carries a quarter of the intensity.
