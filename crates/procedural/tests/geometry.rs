@@ -365,6 +365,9 @@ fn hair_strands_follow_the_fibonacci_lattice_and_their_waves() {
     let step = 0.6 / segments as f32;
     let root_radius = 0.25 / (strands as f32).sqrt();
     assert_eq!(root_radius, 0.0125);
+    // Framed from slightly above, looking a little below the ball's centre, 40° high.
+    let camera = &g.scene.camera;
+    assert_eq!((camera.from, camera.at, camera.vfov), (Vec3::new(0.0, 0.9, 4.6), Vec3::new(0.0, -0.1, 0.0), 40.0));
     let mut rng = raylab_core::Pcg32::new(2018, strands as u64);
     for (k, c) in curves.iter().enumerate() {
         // The azimuth in f64: the generator's f32 golden angle times k (up to 399) is off by up
