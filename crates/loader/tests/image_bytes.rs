@@ -217,6 +217,9 @@ fn netpbm_headers_out_of_range_are_refused_by_name() {
     assert_eq!(e("x.ppm", b"P6 2 1 256\n\0\0\0\0\0\0\0\0\0\0\0"), "x.ppm: truncated: expected 12 bytes of pixels");
     assert_eq!(e("x.ppm", b"P6 2 1"), "x.ppm: truncated header");
     assert_eq!(e("x.ppm", b"P6 2 1 # no maxval\n"), "x.ppm: truncated header");
+    // A comment running to the end of the file, and whitespace at its end.
+    assert_eq!(e("x.ppm", b"P6 2 1 # no maxval, no newline"), "x.ppm: truncated header");
+    assert_eq!(e("x.ppm", b"P6 2 1 \n\t "), "x.ppm: truncated header");
     assert_eq!(e("x.ppm", b"P6 two 1 255\n"), "x.ppm: header: width `two` is not a valid number");
     assert_eq!(e("x.ppm", b"P6 2 -1 255\n"), "x.ppm: header: height `-1` is not a valid number");
     assert_eq!(e("x.pfm", b"PF 1 1 one\n"), "x.pfm: header: scale `one` is not a valid number");
