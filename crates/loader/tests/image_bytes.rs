@@ -350,3 +350,26 @@ fn exr_bounds_are_the_layer_and_the_block_against_8192_times_the_file() {
     assert!(e("o.exr", &exr_header_only(3, 0, h - 1)).starts_with("o.exr: cannot decode OpenEXR: "));
     assert_eq!(e("t.exr", &exr_header_only(3, 0, h)), format!("t.exr: its 1×{} layer cannot be stored in a file of {len} bytes", h + 1));
 }
+
+/// `decode_image`'s "image has no pixels" cannot fire: every decoder refuses an empty image
+/// first, each with its own message (so `w == 0 || h == 0` → `&&` is equivalent).
+#[test]
+fn no_decoder_returns_an_empty_image() {
+    let e = |name: &str, bytes: &[u8]| decode_image(Path::new(name), bytes, false).unwrap_err().to_string();
+    // PNG_2X1 with width 0 in IHDR (and its CRC, from Python's `zlib`, 0x7fb538e0).
+    let mut png = PNG_2X1.to_vec();
+    png[16..20].copy_from_slice(&[0, 0, 0, 0]);
+    png[29..33].copy_from_slice(&[0x7f, 0xb5, 0x38, 0xe0]);
+    let m = e("x.png", &png);
+    assert!(m.starts_with("x.png: cannot decode image: ") && m.contains("Invalid image dimensions"), "{m}");
+    // OpenEXR with a data window of width 0 ((0, 0)–(−1, 0)): header only, and with an
+    // offset table and its one (empty) line.
+    assert!(e("x.exr", &exr_header_only(0, -1, 0)).starts_with("x.exr: cannot decode OpenEXR: "));
+    let mut exr = exr_header_only(0, -1, 0);
+    let first = exr.len() + 8;
+    exr.extend((first as u64).to_le_bytes());
+    exr.extend(i32s(&[0, 0]));
+    assert!(e("x.exr", &exr).starts_with("x.exr: cannot decode OpenEXR: "), "{}", e("x.exr", &exr));
+    assert_eq!(e("x.ppm", b"P6 0 1 255\n"), "x.ppm: header: size 0x1 out of range (1..=65536)");
+    assert_eq!(e("x.pfm", b"PF 1 0 -1\n"), "x.pfm: header: size 1x0 out of range (1..=65536)");
+}
