@@ -317,7 +317,7 @@ fn exr_header_only(compression: u8, max_x: i32, max_y: i32) -> Vec<u8> {
     attribute(&mut f, "screenWindowCenter", "v2f", &le(&[0.0, 0.0]));
     attribute(&mut f, "screenWindowWidth", "float", &1.0f32.to_le_bytes());
     // A comment padding the file to a multiple of 3 bytes, so that 8192·len/12 is whole.
-    let pad = (0..3).find(|k| (f.len() + 20 + (1 + k) + 1) % 3 == 0).unwrap();
+    let pad = (0..3).find(|k| (f.len() + 20 + (1 + k) + 1).is_multiple_of(3)).unwrap();
     attribute(&mut f, "comments", "string", &vec![b'x'; 1 + pad]);
     f.push(0);
     f
@@ -334,7 +334,7 @@ fn exr_header_only(compression: u8, max_x: i32, max_y: i32) -> Vec<u8> {
 fn exr_bounds_are_the_layer_and_the_block_against_8192_times_the_file() {
     let zip = exr_header_only(3, 99_999, 0);
     let len = zip.len();
-    assert!(len % 3 == 0 && 1_200_000 <= len * 8192 && len * 8192 < 19_200_000, "{len}");
+    assert!(len.is_multiple_of(3) && 1_200_000 <= len * 8192 && len * 8192 < 19_200_000, "{len}");
     let e = |name: &str, bytes: &[u8]| decode_image(Path::new(name), bytes, false).unwrap_err().to_string();
     assert_eq!(e("z.exr", &zip), format!("z.exr: its blocks of 16 scan lines cannot be stored in a file of {len} bytes"));
     assert!(e("r.exr", &exr_header_only(0, 99_999, 0)).starts_with("r.exr: cannot decode OpenEXR: "));

@@ -284,7 +284,8 @@ fn mountain_level_two_heights_are_the_neighbours_means_plus_the_draws() {
     let mut rng = raylab_core::Pcg32::new(1987, 2);
     let mut h = [[0.0f32; 5]; 5]; // h[y][x]; the four corners stay 0
     // (x, y), its neighbours (x, y) in the order summed, the amplitude.
-    let order: [((usize, usize), &[(usize, usize)], f32); 21] = [
+    type Displaced = ((usize, usize), &'static [(usize, usize)], f32);
+    let order: [Displaced; 21] = [
         // Level 1, step 4, half 2: the centre from the four corners...
         ((2, 2), &[(0, 0), (4, 0), (0, 4), (4, 4)], 0.5),
         // ...the edge midpoints from the three neighbours inside the grid (two corners, the centre).
