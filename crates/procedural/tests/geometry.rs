@@ -271,3 +271,128 @@ fn the_mountain_is_midpoint_displacement_within_its_amplitudes() {
     assert!(rough < n * n / 100, "{rough} steep steps");
     assert_eq!(g.scene.camera.from, Vec3::new(0.0, 2.2, 4.0));
 }
+
+/// Level 2 of the diamond-square (a 5 × 5 grid), height by height. The draws come from the
+/// generator's own stream (`Pcg32::new(1987, size)`), taken here in the order the algorithm
+/// visits the points: a level's diamond centres row by row, then its edge midpoints row by
+/// row. Each height is the mean of the neighbours listed by hand (diagonal corners for a
+/// centre; the in-grid ones of left, right, up, down for an edge midpoint) plus the level's
+/// amplitude (0.5, then 0.5·0.55 = 0.275) times a draw mapped to [−1, 1).
+#[test]
+fn mountain_level_two_heights_are_the_neighbours_means_plus_the_draws() {
+    let n = 4usize;
+    let mut rng = raylab_core::Pcg32::new(1987, 2);
+    let mut h = [[0.0f32; 5]; 5]; // h[y][x]; the four corners stay 0
+    // (x, y), its neighbours (x, y) in the order summed, the amplitude.
+    type Displaced = ((usize, usize), &'static [(usize, usize)], f32);
+    let order: [Displaced; 21] = [
+        // Level 1, step 4, half 2: the centre from the four corners...
+        ((2, 2), &[(0, 0), (4, 0), (0, 4), (4, 4)], 0.5),
+        // ...the edge midpoints from the three neighbours inside the grid (two corners, the centre).
+        ((2, 0), &[(0, 0), (4, 0), (2, 2)], 0.5),
+        ((0, 2), &[(2, 2), (0, 0), (0, 4)], 0.5),
+        ((4, 2), &[(2, 2), (4, 0), (4, 4)], 0.5),
+        ((2, 4), &[(0, 4), (4, 4), (2, 2)], 0.5),
+        // Level 2, step 2, half 1: four diamond centres from their diagonal neighbours...
+        ((1, 1), &[(0, 0), (2, 0), (0, 2), (2, 2)], 0.275),
+        ((3, 1), &[(2, 0), (4, 0), (2, 2), (4, 2)], 0.275),
+        ((1, 3), &[(0, 2), (2, 2), (0, 4), (2, 4)], 0.275),
+        ((3, 3), &[(2, 2), (4, 2), (2, 4), (4, 4)], 0.275),
+        // ...then the twelve edge midpoints, rows 0 to 4 (even rows start at x = 1, odd rows at 0).
+        ((1, 0), &[(0, 0), (2, 0), (1, 1)], 0.275),
+        ((3, 0), &[(2, 0), (4, 0), (3, 1)], 0.275),
+        ((0, 1), &[(1, 1), (0, 0), (0, 2)], 0.275),
+        ((2, 1), &[(1, 1), (3, 1), (2, 0), (2, 2)], 0.275),
+        ((4, 1), &[(3, 1), (4, 0), (4, 2)], 0.275),
+        ((1, 2), &[(0, 2), (2, 2), (1, 1), (1, 3)], 0.275),
+        ((3, 2), &[(2, 2), (4, 2), (3, 1), (3, 3)], 0.275),
+        ((0, 3), &[(1, 3), (0, 2), (0, 4)], 0.275),
+        ((2, 3), &[(1, 3), (3, 3), (2, 2), (2, 4)], 0.275),
+        ((4, 3), &[(3, 3), (4, 2), (4, 4)], 0.275),
+        ((1, 4), &[(0, 4), (2, 4), (1, 3)], 0.275),
+        ((3, 4), &[(2, 4), (4, 4), (3, 3)], 0.275),
+    ];
+    for ((x, y), neighbours, amp) in order {
+        let mean = neighbours.iter().map(|&(i, j)| h[j][i]).sum::<f32>() / neighbours.len() as f32;
+        h[y][x] = mean + amp * (2.0 * rng.next_f32() - 1.0);
+    }
+    let (v, _) = mesh("mount", 2);
+    for y in 0..=n {
+        for x in 0..=n {
+            // Heights below −0.3 are clamped there.
+            let expected = h[y][x].max(-0.3);
+            assert!((v[y * (n + 1) + x].y - expected).abs() < 1e-6, "({x}, {y}): {} against {expected}", v[y * (n + 1) + x].y);
+        }
+    }
+    // The test would be weak where the clamp hides a height: none is clamped here.
+    assert!(h.iter().flatten().all(|&y| y > -0.3), "{h:?}");
+    // The four spheres resting on it, as written, alternating mirror and `a`.
+    let g = generate("mount", size(2)).unwrap();
+    let balls: Vec<_> = g.scene.geometry.spheres.iter().map(|s| (s.center, s.radius, g.scene.material_names[s.material.0 as usize].as_str())).collect();
+    let centres = [Vec3::new(-0.8, 0.9, 0.3), Vec3::new(0.7, 0.8, -0.4), Vec3::new(0.1, 1.1, -1.0), Vec3::new(-0.2, 0.8, 0.9)];
+    assert_eq!(balls, centres.iter().zip(["mirror", "a", "mirror", "a"]).map(|(&c, m)| (c, 0.25, m)).collect::<Vec<_>>());
+    let m = &g.scene.geometry.meshes[0];
+    assert_eq!((m.name.as_str(), g.scene.material_names[m.material.0 as usize].as_str()), ("mountain", "b"));
+}
+
+/// The Catmull–Rom points of a strand, p0 ..= p(segments + 2), recovered from its Bézier
+/// segments: segment i is [p(i+1), p(i+1) + (p(i+2) − p(i))/6, p(i+2) − (p(i+3) − p(i+1))/6, p(i+2)].
+fn catmull_rom_points(c: &raylab_render::shape::Curve) -> Vec<raylab_core::Vec4> {
+    let s = &c.segments;
+    let mut p: Vec<_> = s.iter().map(|b| b.control_points()[0]).chain([s.last().unwrap().control_points()[3]]).collect();
+    let first = p[1] - 6.0 * (s[0].control_points()[1] - p[0]);
+    let m = p.len();
+    let last = p[m - 2] + 6.0 * (p[m - 1] - s.last().unwrap().control_points()[2]);
+    p.insert(0, first);
+    p.push(last);
+    p
+}
+
+/// The furry ball strand by strand, from its construction written out here: roots on the
+/// Fibonacci lattice (height 1 − 2(k + ½)/N, azimuth k times the golden angle
+/// π(3 − √5) = 137.5077640500378°), a phantom point one step inside, then steps of 0.6/S along
+/// n − 1.2·along·ŷ + w·(sin a·x̂ + cos a·ŷ) normalised, with (x̂, ŷ) the frame around n, a the
+/// strand's phase plus 2.5 rad per point, w = 0.3 + 0.4·u and phase 2π·u from the strand's
+/// two draws of `Pcg32::new(2018, N)`; radii from 0.25/√N (inside [0.001, 0.02]) tapering by
+/// 0.67·along. N = 400 gives a root radius of 0.0125, inside the clamp.
+#[test]
+fn hair_strands_follow_the_fibonacci_lattice_and_their_waves() {
+    let (strands, segments) = (400u32, 3u32);
+    let g = generate("hair", Size { size: 0, strands, segments }).unwrap();
+    let curves = &g.scene.geometry.curves;
+    assert_eq!(curves.len(), strands as usize);
+    let golden = 137.507_764_050_037_85f64.to_radians();
+    assert!((golden - std::f64::consts::PI * (3.0 - 5f64.sqrt())).abs() < 1e-14);
+    let step = 0.6 / segments as f32;
+    let root_radius = 0.25 / (strands as f32).sqrt();
+    assert_eq!(root_radius, 0.0125);
+    // Framed from slightly above, looking a little below the ball's centre, 40° high.
+    let camera = &g.scene.camera;
+    assert_eq!((camera.from, camera.at, camera.vfov), (Vec3::new(0.0, 0.9, 4.6), Vec3::new(0.0, -0.1, 0.0), 40.0));
+    let mut rng = raylab_core::Pcg32::new(2018, strands as u64);
+    for (k, c) in curves.iter().enumerate() {
+        // The azimuth in f64: the generator's f32 golden angle times k (up to 399) is off by up
+        // to ~10⁻⁴ rad, hence the tolerance on positions below (a changed lattice or wave moves
+        // points by 10⁻³ or more).
+        let y = 1.0 - 2.0 * (k as f64 + 0.5) / strands as f64;
+        let theta = golden * k as f64;
+        let ring = (1.0 - y * y).sqrt();
+        let n = Vec3::new((ring * theta.cos()) as f32, y as f32, (ring * theta.sin()) as f32);
+        let frame = raylab_core::Frame::from_z(n);
+        let phase = std::f32::consts::TAU * rng.next_f32();
+        let wave = 0.3 + 0.4 * rng.next_f32();
+        let p = catmull_rom_points(c);
+        assert_eq!(p.len(), segments as usize + 3);
+        let mut q = (1.0 - step) * n;
+        for (j, got) in p.iter().enumerate() {
+            // The first two points (the phantom and the root) both have along = 0.
+            let along = j.saturating_sub(1) as f32 / segments as f32;
+            let radius = root_radius * (1.0 - 0.67 * along.min(1.0));
+            assert!(got.truncate().distance(q) < 2e-4, "strand {k}, point {j}: {got} against {q}");
+            assert!((got.w - radius).abs() < 1e-7, "strand {k}, point {j}: radius {} against {radius}", got.w);
+            let a = phase + 2.5 * j as f32;
+            let dir = n - 1.2 * along * Vec3::Y + wave * (a.sin() * frame.x + a.cos() * frame.y);
+            q += step * dir.normalize();
+        }
+    }
+}

@@ -354,6 +354,110 @@ mod tests {
         assert_eq!("gamma".parse::<Tonemap>().unwrap_err().to_string(), "unknown tone map `gamma` (valid: clamp, reinhard, aces)");
     }
 
+    /// Narkowicz 2016, "ACES Filmic Tone Mapping Curve", in f64: x(2.51x + 0.03) / (x(2.43x + 0.59) + 0.14).
+    fn aces(x: f64) -> f64 {
+        (x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0)
+    }
+
+    #[test]
+    fn tone_maps_at_published_points() {
+        // Reinhard et al. 2002, c / (1 + c): 1 → 1/2, 3 → 3/4, 0.25 → 1/5, 9 → 0.9.
+        for (v, expected) in [(1.0f32, 0.5f32), (3.0, 0.75), (0.25, 0.2), (9.0, 0.9)] {
+            assert!((Tonemap::Reinhard.apply(v, 0.0) - expected).abs() < 1e-6, "Reinhard({v})");
+        }
+        // ACES(1) = 2.54/3.16 = 0.803 797; ACES(0.18) = 0.0 867/0.324 9 ≈ 0.266 90 (18 % grey);
+        // the fit reaches 1 at x = (0.56 + √0.3584)/0.16 ≈ 7.24.
+        assert!((Tonemap::Aces.apply(1.0, 0.0) as f64 - 2.54 / 3.16).abs() < 1e-6);
+        assert!((Tonemap::Aces.apply(0.18, 0.0) as f64 - 0.180 * (2.51 * 0.18 + 0.03) / (0.18 * (2.43 * 0.18 + 0.59) + 0.14)).abs() < 1e-6);
+        assert!((Tonemap::Aces.apply(0.18, 0.0) - 0.266_90).abs() < 1e-4);
+        for x in [0.001f32, 0.01, 0.05, 0.3, 0.5, 0.7, 2.0, 5.0, 7.2] {
+            assert!((Tonemap::Aces.apply(x, 0.0) as f64 - aces(x as f64)).abs() < 1e-6, "ACES({x}) = {} against {}", Tonemap::Aces.apply(x, 0.0), aces(x as f64));
+        }
+        assert!(Tonemap::Aces.apply(7.2, 0.0) < 1.0);
+        assert_eq!([Tonemap::Aces.apply(7.3, 0.0), Tonemap::Aces.apply(1e4, 0.0), Tonemap::Aces.apply(2e4, 0.0)], [1.0; 3]);
+        // Exposure scales by 2^stops before the curve: 0.25 at +2 stops is 1; 4 at −2 is 1.
+        for t in Tonemap::ALL {
+            assert_eq!(t.apply(0.25, 2.0), t.apply(1.0, 0.0), "{t:?}");
+            assert_eq!(t.apply(4.0, -2.0), t.apply(1.0, 0.0), "{t:?}");
+            assert_eq!(t.apply(3.0, 1.0), t.apply(6.0, 0.0), "{t:?}");
+        }
+        assert_eq!(Tonemap::Clamp.apply(0.3, 1.0), 0.6);
+        assert_eq!(Tonemap::Reinhard.apply(0.5, 1.0), 0.5);
+        // Zero, negative and non-finite radiance give 0; small positive values pass through.
+        for t in Tonemap::ALL {
+            for v in [0.0, -0.0, -1.0, f32::NEG_INFINITY, f32::INFINITY, f32::NAN] {
+                assert_eq!(t.apply(v, 0.0), 0.0, "{t:?}({v})");
+            }
+        }
+        assert_eq!(Tonemap::Clamp.apply(1e-3, 0.0), 1e-3);
+        assert!((Tonemap::Reinhard.apply(1e-3, 0.0) - 1e-3 / 1.001).abs() < 1e-9);
+    }
+
+    #[test]
+    fn exposures_beyond_64_stops_or_not_finite_are_refused() {
+        for e in [64.0f32, -64.0, 0.0, 63.5] {
+            assert_eq!(check_exposure(e), Ok(()), "{e}");
+        }
+        for e in [64.001f32, -64.001, 128.0, f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            assert_eq!(check_exposure(e), Err(format!("exposure {e} out of range (-64 to 64 stops)")), "{e}");
+        }
+    }
+
+    /// Decodes 8-bit RGB PNG bytes with the `image` crate's decoder: (width, height, bytes).
+    fn png_codes(bytes: &[u8]) -> (u32, u32, Vec<u8>) {
+        let img = image::load_from_memory(bytes).unwrap().to_rgb8();
+        (img.width(), img.height(), img.into_raw())
+    }
+
+    #[test]
+    fn png_codes_are_tone_mapped_then_srgb_encoded() {
+        // Reinhard: 1 → 0.5 → sRGB 0.735 4 → 188 (IEC 61966-2-1); 3 → 0.75 → 0.880 8 → 225;
+        // 0.25 → 0.2 → 0.484 5 → 124; 0 → 0. Three columns, two rows, in order.
+        let pixels = [Rgb::new(1.0, 3.0, 0.0), Rgb::new(0.25, 1.0, 0.0), Rgb::ZERO, Rgb::ONE, Rgb::splat(3.0), Rgb::new(0.0, 0.0, 0.25)];
+        let (w, h, codes) = png_codes(&encode_png(3, 2, &pixels, Tonemap::Reinhard, 0.0).unwrap());
+        assert_eq!((w, h), (3, 2));
+        assert_eq!(codes, [188, 225, 0, 124, 188, 0, 0, 0, 0, 188, 188, 188, 225, 225, 225, 0, 0, 124]);
+        // Through `encode_image` and a `.png` path, with one stop of exposure: 0.5 → 1 → 188.
+        let (_, _, codes) = png_codes(&encode_image(Path::new("t.png"), 1, 1, &[Rgb::splat(0.5)], Tonemap::Reinhard, 1.0).unwrap());
+        assert_eq!(codes, [188, 188, 188]);
+        assert_eq!(encode_png(2, 2, &pixels, Tonemap::Clamp, 0.0).unwrap_err().to_string(), "<png>: 6 pixels for a 2×2 image");
+        assert_eq!(encode_png(1, 1, &[Rgb::ONE], Tonemap::Clamp, f32::NAN).unwrap_err().to_string(), "<png>: exposure NaN out of range (-64 to 64 stops)");
+    }
+
+    #[test]
+    fn linear_png_holds_round_255_v() {
+        // round(255 · v) with no curve: 0.5 → 127.5 → 128, 0.2 → 51, 1 → 255; out of [0, 1]
+        // clamped; NaN as 0.
+        let path = std::env::temp_dir().join(format!("raylab-image-out-linear-{}.png", std::process::id()));
+        write_linear_png(&path, 2, 1, &[Rgb::new(0.5, 0.2, 1.0), Rgb::new(1.5, -1.0, f32::NAN)]).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        assert_eq!(png_codes(&bytes), (2, 1, vec![128, 51, 255, 255, 0, 0]));
+        assert_eq!(write_linear_png(&path, 3, 1, &[Rgb::ONE]).unwrap_err().to_string(), format!("{}: 1 pixels for a 3×1 image", path.display()));
+    }
+
+    #[test]
+    fn float_formats_keep_each_pixel_in_place() {
+        // 3 × 2, top row first in memory; every channel a different number.
+        let pixels: Vec<Rgb> = (0..6).map(|i| Rgb::new(i as f32, 10.0 + i as f32, 100.0 + i as f32)).collect();
+        let c = read_channels(&encode_image(Path::new("t.exr"), 3, 2, &pixels, Tonemap::Aces, 0.0).unwrap());
+        assert_eq!(c["R"], [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
+        assert_eq!(c["G"], [10.0, 11.0, 12.0, 13.0, 14.0, 15.0]);
+        assert_eq!(c["B"], [100.0, 101.0, 102.0, 103.0, 104.0, 105.0]);
+        // PFM: the bottom row first, little endian (scale −1.0), exposure −1 halving.
+        let bytes = encode_image(Path::new("T.PFM"), 3, 2, &pixels, Tonemap::Aces, -1.0).unwrap();
+        let mut expected = b"PF\n3 2\n-1.0\n".to_vec();
+        for i in [3, 4, 5, 0, 1, 2] {
+            for v in [i as f32, 10.0 + i as f32, 100.0 + i as f32] {
+                expected.extend((v / 2.0).to_le_bytes());
+            }
+        }
+        assert_eq!(bytes, expected);
+        // PPM: the header, then the top row first.
+        let bytes = encode_image(Path::new("t.ppm"), 1, 2, &[Rgb::ONE, Rgb::ZERO], Tonemap::Clamp, 0.0).unwrap();
+        assert_eq!(bytes, b"P6\n1 2\n255\n\xff\xff\xff\x00\x00\x00");
+    }
+
     /// The channels of a multi-layer EXR, read back with the exr crate: name -> values.
     fn read_channels(bytes: &[u8]) -> std::collections::BTreeMap<String, Vec<f32>> {
         use exr::prelude::*;
