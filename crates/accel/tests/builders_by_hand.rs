@@ -256,6 +256,12 @@ fn binned_sah_picks_the_cheapest_plane_of_all_axes() {
     let st = b.stats();
     assert_eq!((st.interior_nodes, st.leaves, st.max_depth, st.references), (3, 4, 4, 4));
     assert_eq!(st.memory_bytes, 7 * 32 + 4 * 4);
+    assert_eq!((st.name.as_str(), st.primitives), ("bvh", 4));
+    assert_eq!(b.root_bounds(), aabb([0.0; 3], [4.0, 4.0, 1.0]));
+    // Built through `AnyAccel`, the build time reaches the stats.
+    let any = raylab_accel::AnyAccel::build(raylab_accel::AccelKind::BvhMedian, &s, &BuildOptions::default());
+    assert!(any.stats().build_ms > 0.0);
+    assert_eq!(any.stats().name, "bvh-median");
 }
 
 #[test]
@@ -389,18 +395,26 @@ fn binned_sah_on_a_line_prices_every_split_as_the_whole_node() {
 
 #[test]
 fn trees_are_cut_at_depth_64() {
-    // Point boxes at x = 3^k, k = 0 .. 79: the midpoint of [1, 3^m], about 1.5·3^(m−1),
-    // separates only the farthest (with 2^k it would round onto 2^(m−1) once 1 + 2^m rounds to
-    // 2^m), so the midpoint tree is a chain; a node at depth d (root 1) holds 81 − d
-    // primitives. At depth 64 the node of 17 becomes a leaf: 63 interior nodes, 63 leaves of
-    // one (the right children at depths 2 .. 64) and the leaf of 17.
-    let s = Boxes((0..80).map(|k| { let x = 3.0f32.powi(k); aabb([x, 0.0, 0.0], [x, 0.0, 0.0]) }).collect());
-    let b = Bvh::build(&s, SplitMethod::Midpoint, &opts(1.0, 1.0, 1, 16));
-    b.validate(&s).unwrap();
-    let st = b.stats();
-    assert_eq!((st.max_depth, st.interior_nodes, st.leaves, st.references), (64, 63, 64, 80));
-    assert_eq!(st.leaf_histogram[1], 63);
-    assert_eq!(st.leaf_histogram[16], 1, "the leaf of 17 goes to the last bucket, 16+");
+    // Point boxes at x = 3^k, k = 1 .. 79, and `extra` more at x = 1: the midpoint of
+    // [1, 3^m], about 1.5·3^(m−1), separates only the farthest (with 2^k it would round onto
+    // 2^(m−1) once 1 + 2^m rounds to 2^m), so the midpoint tree is a chain; a node at depth d
+    // (root 1) holds extra + 81 − d primitives. At depth 64 it becomes a leaf of extra + 17:
+    // 63 interior nodes, 63 leaves of one (the peeled points at depths 2 .. 64) and that leaf.
+    // Mirrored (x = −3^k) the chain runs down the right children instead of the left; with
+    // 4100 extra points the nodes of the chain hold over 4096 primitives, so their children
+    // are built in parallel (`rayon::join`), which has its own depth and offset arithmetic.
+    for sign in [1.0f32, -1.0] {
+        for extra in [1usize, 4100] {
+            let point = |x: f32| aabb([sign * x, 0.0, 0.0], [sign * x, 0.0, 0.0]);
+            let s = Boxes((1..80).map(|k| point(3.0f32.powi(k))).chain((0..extra).map(|_| point(1.0))).collect());
+            let b = Bvh::build(&s, SplitMethod::Midpoint, &opts(1.0, 1.0, 1, 16));
+            b.validate(&s).unwrap_or_else(|e| panic!("sign {sign}, extra {extra}: {e}"));
+            let st = b.stats();
+            assert_eq!((st.max_depth, st.interior_nodes, st.leaves, st.references), (64, 63, 64, 79 + extra), "sign {sign}, extra {extra}");
+            assert_eq!(st.leaf_histogram[1], 63);
+            assert_eq!(st.leaf_histogram[16], 1, "the leaf of {} goes to the last bucket, 16+", extra + 16);
+        }
+    }
 }
 
 #[test]
@@ -506,4 +520,23 @@ fn validate_accepts_a_good_tree_and_rejects_each_broken_invariant() {
     clipped.with_spatial_splits().validate(&prims).unwrap();
     let apart = Bvh::from_parts(vec![root, leaf([0.0; 3], [1.0; 3], 0, 1), leaf([0.0; 3], [1.0; 3], 1, 1)], vec![0, 1], 2, "t");
     rejects(&apart.with_spatial_splits(), &prims, "primitive 1 does not touch leaf 2");
+}
+
+#[test]
+fn sah_cost_formula_by_hand() {
+    use raylab_accel::bvh::SahCost;
+    let sah = SahCost { traversal: 0.5, intersection: 2.0 };
+    // Parent 2 x 1 x 1 (half area 5), children unit cubes (3) with 3 and 1 primitives:
+    // 0.5 + 2·(3·3 + 3·1)/5 = 0.5 + 4.8 = 5.3.
+    let parent = aabb([0.0; 3], [2.0, 1.0, 1.0]);
+    let (l, r) = (aabb([0.0; 3], [1.0; 3]), aabb([1.0, 0.0, 0.0], [2.0, 1.0, 1.0]));
+    assert!((sah.split(&parent, &l, 3, &r, 1) - 5.3).abs() < 1e-5);
+    // Left 1 x 1 x 1 with 2, right 2 x 1 x 1 (5) with 4 inside a 2 x 2 x 1 parent (4 + 2 + 2 = 8):
+    // 0.5 + 2·(3·2 + 5·4)/8 = 0.5 + 6.5 = 7.
+    assert!((sah.split(&aabb([0.0; 3], [2.0, 2.0, 1.0]), &l, 2, &parent, 4) - 7.0).abs() < 1e-5);
+    // A flat parent (a unit square, half area 0): every ray that hits it hits both children,
+    // 0.5 + 2·(2 + 3) = 10.5.
+    let flat = aabb([0.0; 3], [1.0, 1.0, 0.0]);
+    assert_eq!(sah.split(&flat, &flat, 2, &flat, 3), 10.5);
+    assert_eq!(sah.leaf(5), 10.0);
 }
