@@ -315,10 +315,22 @@ fn binned_sah_bins_by_centroid_position() {
     // bin width 6.5: the first four in bin 0. Cost 1 + (4·(4 + 1 + 4)·2)/(14 + 1 + 14) =
     // 1 + 72/29 = 3.48 < 8: split in the middle; each half (area 9) splits {0,1}|{2,3} at 2
     // bins of width 1.5: 1 + (5·2 + 5·2)/9 = 3.22 < 4; pairs (area 5) cost 1 + 6/5 = 2.2 >= 2: leaves.
-    let s = Boxes([0.0, 1.0, 2.0, 3.0, 10.0, 11.0, 12.0, 13.0].iter().map(|&x| aabb([x, 0.0, 0.0], [x + 1.0, 1.0, 1.0])).collect());
-    let b = Bvh::build(&s, SplitMethod::BinnedSah, &opts(1.0, 1.0, 8, 2));
-    b.validate(&s).unwrap();
-    assert_eq!(shape(&b), "(([0 1] [2 3]) ([4 5] [6 7]))");
+    // The same along y and along z (each axis has its own bins and counts).
+    for axis in 0..3 {
+        let s = Boxes(
+            [0.0, 1.0, 2.0, 3.0, 10.0, 11.0, 12.0, 13.0]
+                .iter()
+                .map(|&x| {
+                    let (mut min, mut max) = ([0.0f32; 3], [1.0f32; 3]);
+                    (min[axis], max[axis]) = (x, x + 1.0);
+                    aabb(min, max)
+                })
+                .collect(),
+        );
+        let b = Bvh::build(&s, SplitMethod::BinnedSah, &opts(1.0, 1.0, 8, 2));
+        b.validate(&s).unwrap();
+        assert_eq!(shape(&b), "(([0 1] [2 3]) ([4 5] [6 7]))", "along axis {axis}");
+    }
 }
 
 #[test]
@@ -387,8 +399,9 @@ fn binned_sah_on_a_line_prices_every_split_as_the_whole_node() {
     // cheaper, so three stay in one leaf unless the leaf size forces a split.
     let s = Boxes([0.0, 1.0, 2.0].iter().map(|&x| aabb([x, 0.0, 0.0], [x, 0.0, 0.0])).collect());
     assert_eq!(shape(&Bvh::build(&s, SplitMethod::BinnedSah, &opts(1.0, 1.0, 8, 16))), "[0 1 2]");
-    // T = 1, I = 3: 1 + 9 >= 9, still a leaf.
+    // T = 1, I = 3: 1 + 9 >= 9, still a leaf; T = 0.5, I = 1: 0.5 + 3 >= 3.
     assert_eq!(shape(&Bvh::build(&s, SplitMethod::BinnedSah, &opts(1.0, 3.0, 8, 16))), "[0 1 2]");
+    assert_eq!(shape(&Bvh::build(&s, SplitMethod::BinnedSah, &opts(0.5, 1.0, 8, 16))), "[0 1 2]");
     // Forced: bins of width 0.5 put 0, 1, 2 in bins 0, 2, 3; the first plane separates 0.
     assert_eq!(shape(&Bvh::build(&s, SplitMethod::BinnedSah, &opts(1.0, 1.0, 1, 4))), "(0 (1 2))");
 }
