@@ -553,3 +553,19 @@ fn sah_cost_formula_by_hand() {
     assert_eq!(sah.split(&flat, &flat, 2, &flat, 3), 10.5);
     assert_eq!(sah.leaf(5), 10.0);
 }
+
+#[test]
+fn ploc_pairs_up_identical_boxes_in_one_round() {
+    // 4096 identical boxes: every distance ties, so the tie-break decides. Pairing positions
+    // (0, 1), (2, 3), ... each round halves the clusters: a complete binary tree of depth 12,
+    // which the SAH collapse cuts into leaves of 8 (a subtree of k identical boxes of area A
+    // costs k·A as a leaf against A + k·A split; 16 exceed the leaf size): 512 leaves, 511
+    // interior nodes, depth 10 with the root at 1. (Ties by position alone paired only the
+    // lowest two each round: 4095 rounds, a chain cut at depth 64 into a leaf of 4033.)
+    let s = Boxes(vec![aabb([0.0; 3], [1.0; 3]); 4096]);
+    let b = bvh::ploc::build(&s, &BuildOptions::default());
+    b.validate(&s).unwrap();
+    let st = b.stats();
+    assert_eq!((st.max_depth, st.interior_nodes, st.leaves, st.references), (10, 511, 512, 4096));
+    assert_eq!(st.leaf_histogram[8], 512);
+}
