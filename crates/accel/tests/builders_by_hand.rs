@@ -569,3 +569,24 @@ fn ploc_pairs_up_identical_boxes_in_one_round() {
     assert_eq!((st.max_depth, st.interior_nodes, st.leaves, st.references), (10, 511, 512, 4096));
     assert_eq!(st.leaf_histogram[8], 512);
 }
+
+#[test]
+fn ploc_chain_of_nested_boxes_is_cut_at_depth_64() {
+    // 100 nested cubes [0, 1 + k]³: the union of two is the larger, so a cluster's nearest is
+    // the next larger cube (ties between lower ones go to the nearest on the curve), and only
+    // the lowest pair is mutual: each round the cluster of cubes 0 .. k takes cube k + 1, a
+    // chain. The SAH collapse keeps it (a leaf of k + 1 cubes costs (k + 1)·A_k against a split
+    // of 2·A_k plus the smaller cluster's cost: only cubes 0 and 1 collapse), so the cut at
+    // depth 64 makes it: interior nodes at depths 1 .. 63 (root 1), each with a cube as right
+    // child, and at depth 64 the cluster of the 37 smallest as one leaf.
+    let s = Boxes((0..100).map(|k| aabb([0.0; 3], [1.0 + k as f32; 3])).collect());
+    let b = bvh::ploc::build(&s, &BuildOptions::default());
+    b.validate(&s).unwrap();
+    let st = b.stats();
+    assert_eq!((st.max_depth, st.interior_nodes, st.leaves, st.references), (64, 63, 64, 100));
+    assert_eq!(st.leaf_histogram[1], 63);
+    assert_eq!(st.leaf_histogram[16], 1, "the leaf of 37");
+    // The root's right child is the largest cube.
+    let l = b.nodes[0].left_first as usize;
+    assert_eq!(b.indices[b.nodes[l + 1].left_first as usize], 99);
+}
