@@ -590,3 +590,27 @@ fn ploc_chain_of_nested_boxes_is_cut_at_depth_64() {
     let l = b.nodes[0].left_first as usize;
     assert_eq!(b.indices[b.nodes[l + 1].left_first as usize], 99);
 }
+
+#[test]
+fn lbvh_radix_tree_of_runs_and_of_spread_codes() {
+    // Equal codes are ordered by position, and the tree over a run is the radix tree of the
+    // positions' bits (Karras §4). A cube at x = 0 (code 0, position 0) and six identical
+    // cubes at x = 10 (the top code, positions 1 .. 6 = 001 .. 110): the codes split 0 from the
+    // run; positions 1 .. 3 and 4 .. 6 differ in bit 2; then {1}|{2, 3} (bit 1) and
+    // {4, 5}|{6} (bit 1). Prims 0 .. 5 are the run in index order, prim 6 the lone cube.
+    let mut cubes = vec![cube_at(10.0, 0.5); 6];
+    cubes.push(cube_at(0.0, 0.5));
+    let s = Boxes(cubes);
+    let b = lbvh::build(&s, &opts(1.0, 1.0, 1, 16));
+    b.validate(&s).unwrap();
+    assert_eq!(shape(&b), "(6 ((0 (1 2)) ((3 4) 5)))");
+    // Eight cubes at x = 128·k (k = 0 .. 7, listed in reverse): 1024 cells over [0, 896]
+    // put them in cells 146.3·k rounded down, 0, 146, 292, 438, 585, 731, 877, 1023 (1024
+    // clamped): x bit 9 (512) splits k < 4 from k >= 4, bit 8 (256) each half again, a
+    // balanced tree.
+    let s = Boxes((0..8).rev().map(|k| cube_at(128.0 * k as f32, 0.1)).collect());
+    let b = lbvh::build(&s, &opts(1.0, 1.0, 1, 16));
+    b.validate(&s).unwrap();
+    // prim p is k = 7 − p.
+    assert_eq!(shape(&b), "(((7 6) (5 4)) ((3 2) (1 0)))");
+}
