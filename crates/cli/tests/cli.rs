@@ -145,7 +145,7 @@ fn bad_input_fails_with_file_line_and_field() {
     fails_with(
         &["render", "--accel", "octree"],
         &dir,
-        "--accel: unknown acceleration structure `octree` (valid: none, bvh, bvh-median, bvh-midpoint, aabb, grid, lbvh, lbvh-ploc, kdtree, sphere-bvh, sbvh, bvh8, bvh4, bvh8-sbvh)",
+        "--accel: unknown acceleration structure `octree` (valid: none, bvh, bvh-median, bvh-midpoint, aabb, grid, lbvh, lbvh-ploc, kdtree, sphere-bvh, sbvh, bvh8, bvh4, bvh8-sbvh, bvh8q)",
     );
     fails_with(&["trace", "radius.toml", "--rays", "absent.rays"], &dir, "absent.rays: cannot open: No such file or directory (os error 2)");
     assert!(!dir.join("raylab.png").exists(), "a failed render must not write an image");
