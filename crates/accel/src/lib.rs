@@ -349,6 +349,32 @@ impl AnyAccel {
         }
     }
 
+    /// [`AnyAccel::intersect_packet`], counting as [`Accel::intersect`] does: wide BVHs
+    /// charge each ray the nodes and triangle lanes it was active in (see `wide::packet`),
+    /// other structures trace the rays one by one. The answers are the same.
+    ///
+    /// # Panics
+    /// As [`AnyAccel::intersect_packet`].
+    pub fn intersect_packet_counted<P: Primitives + ?Sized>(&self, prims: &P, rays: &[Ray], out: &mut [Option<Hit>], c: &mut Counters) {
+        assert!(rays.len() <= PACKET && out.len() == rays.len(), "a packet holds at most {PACKET} rays and as many answers");
+        match self {
+            AnyAccel::Bvh8(a) => a.intersect_packet_counted(prims, rays, out, c),
+            AnyAccel::Bvh4(a) => a.intersect_packet_counted(prims, rays, out, c),
+            AnyAccel::Bvh8Q(a) => a.intersect_packet_counted(prims, rays, out, c),
+            a => {
+                for (o, r) in out.iter_mut().zip(rays) {
+                    *o = a.intersect(prims, r, c);
+                }
+            }
+        }
+    }
+
+    /// Whether [`AnyAccel::intersect_packet`] traverses rays together (wide BVHs) rather
+    /// than one by one.
+    pub fn has_packets(&self) -> bool {
+        matches!(self, AnyAccel::Bvh8(_) | AnyAccel::Bvh4(_) | AnyAccel::Bvh8Q(_))
+    }
+
     /// The kernel of a wide BVH; `None` for other structures.
     pub fn kernel(&self) -> Option<Kernel> {
         match self {

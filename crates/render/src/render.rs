@@ -10,8 +10,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use rayon::prelude::*;
-use raylab_accel::Counters;
-use raylab_core::{Rgb, Vec2};
+use raylab_accel::{Counters, PACKET};
+use raylab_core::{Ray, Rgb, Vec2};
 
 use crate::film::codec::Fnv64;
 use crate::film::{luminance, Crop, Film, FilmError, FilmHeader, CHANNELS, DEFAULT_PASS_SAMPLES};
@@ -139,6 +139,8 @@ fn render_pass(scene: &Scene, film: &Film, pass: u32, control: &Control) -> Opti
     let samples = film.header.pass_range(pass);
     let tiles: Vec<(u32, u32)> = (crop.y0..crop.y1).step_by(TILE as usize).flat_map(|y| (crop.x0..crop.x1).step_by(TILE as usize).map(move |x| (x, y))).collect();
     let stopped = || control.cancel.load(Ordering::Relaxed) || control.deadline.is_some_and(|d| Instant::now() >= d);
+    // Camera rays go in 4×4 packets where the structure traverses them together.
+    let packets = scene.accel().has_packets() && scene.settings.integrator.traces_ahead();
     let done: Vec<Option<(Vec<[f64; CHANNELS]>, Counters, u64)>> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
@@ -148,12 +150,7 @@ fn render_pass(scene: &Scene, film: &Film, pass: u32, control: &Control) -> Opti
             let (x1, y1) = ((x0 + TILE).min(crop.x1), (y0 + TILE).min(crop.y1));
             let mut c = Counters::default();
             let mut bad = 0u64;
-            let mut px = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    px.push(pixel_sums(scene, x, y, samples.clone(), &mut c, &mut bad));
-                }
-            }
+            let px = if packets { tile_sums_packets(scene, (x0, y0, x1, y1), samples.clone(), &mut c, &mut bad) } else { tile_sums(scene, (x0, y0, x1, y1), samples.clone(), &mut c, &mut bad) };
             (control.progress)(px.len() as u64);
             Some((px, c, bad))
         })
@@ -175,28 +172,84 @@ fn render_pass(scene: &Scene, film: &Film, pass: u32, control: &Control) -> Opti
     Some((sums, counters, nonfinite))
 }
 
-/// The sums over the pixel's samples `samples`, in index order, their film positions drawn
-/// from the pixel filter. Non-finite samples are counted in `bad` and left out.
-fn pixel_sums(scene: &Scene, x: u32, y: u32, samples: Range<u32>, c: &mut Counters, bad: &mut u64) -> [f64; CHANNELS] {
+/// A tile's pixels (`x0..x1` × `y0..y1`, row by row): the sums over each pixel's samples
+/// `samples`, in index order. Non-finite samples are counted in `bad` and left out.
+fn tile_sums(scene: &Scene, (x0, y0, x1, y1): (u32, u32, u32, u32), samples: Range<u32>, c: &mut Counters, bad: &mut u64) -> Vec<[f64; CHANNELS]> {
     let s = &scene.settings;
-    let inv = Vec2::new(1.0 / s.width as f32, 1.0 / s.height as f32);
-    let mut sum = [0.0f64; CHANNELS];
-    for i in samples {
-        let mut sampler = PixelSampler::new(s.sampler, s.spp, s.seed, x, y, i);
-        let film = (Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + s.filter.offset(sampler.pixel_2d())) * inv;
-        let ray = scene.camera.ray(film, sampler.get_2d());
-        let l = s.integrator.radiance(scene, &ray, &mut sampler, c);
-        if l.is_finite() {
-            let (r, g, b) = (l.x as f64, l.y as f64, l.z as f64);
-            sum[0] += r;
-            sum[1] += g;
-            sum[2] += b;
-            sum[3] += luminance(r, g, b).powi(2);
-        } else {
-            *bad += 1;
+    let mut px = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let mut sum = [0.0f64; CHANNELS];
+            for i in samples.clone() {
+                let (ray, mut sampler) = camera_ray(scene, x, y, i);
+                add_sample(&mut sum, s.integrator.radiance(scene, &ray, &mut sampler, c), bad);
+            }
+            px.push(sum);
         }
     }
-    sum
+    px
+}
+
+/// [`tile_sums`] with the camera rays of each 4×4 block of the tile traced together as one
+/// packet per sample index. Each pixel's samples keep their random streams and their order,
+/// and packets find the hits single rays find, so the sums are the same bit for bit.
+fn tile_sums_packets(scene: &Scene, (x0, y0, x1, y1): (u32, u32, u32, u32), samples: Range<u32>, c: &mut Counters, bad: &mut u64) -> Vec<[f64; CHANNELS]> {
+    const SIDE: u32 = 4;
+    const { assert!((SIDE * SIDE) as usize == PACKET) };
+    let s = &scene.settings;
+    let tw = x1 - x0;
+    let mut px = vec![[0.0f64; CHANNELS]; (tw * (y1 - y0)) as usize];
+    let mut block: Vec<(u32, u32)> = Vec::with_capacity(PACKET);
+    let mut rays: Vec<Ray> = Vec::with_capacity(PACKET);
+    let mut samplers: Vec<PixelSampler> = Vec::with_capacity(PACKET);
+    let mut hits = [None; PACKET];
+    for by in (y0..y1).step_by(SIDE as usize) {
+        for bx in (x0..x1).step_by(SIDE as usize) {
+            block.clear();
+            block.extend((by..(by + SIDE).min(y1)).flat_map(|y| (bx..(bx + SIDE).min(x1)).map(move |x| (x, y))));
+            for i in samples.clone() {
+                rays.clear();
+                samplers.clear();
+                for &(x, y) in &block {
+                    let (ray, sampler) = camera_ray(scene, x, y, i);
+                    rays.push(ray);
+                    samplers.push(sampler);
+                }
+                let hits = &mut hits[..block.len()];
+                scene.intersect_packet(&rays, hits, c);
+                for (k, &(x, y)) in block.iter().enumerate() {
+                    let l = s.integrator.radiance_traced(scene, &rays[k], hits[k].take(), &mut samplers[k], c);
+                    add_sample(&mut px[((y - y0) * tw + x - x0) as usize], l, bad);
+                }
+            }
+        }
+    }
+    px
+}
+
+/// Sample `i` of pixel (`x`, `y`): its camera ray, its film position drawn from the pixel
+/// filter, and the sampler the integrator goes on with.
+fn camera_ray(scene: &Scene, x: u32, y: u32, i: u32) -> (Ray, PixelSampler) {
+    let s = &scene.settings;
+    let inv = Vec2::new(1.0 / s.width as f32, 1.0 / s.height as f32);
+    let mut sampler = PixelSampler::new(s.sampler, s.spp, s.seed, x, y, i);
+    let film = (Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + s.filter.offset(sampler.pixel_2d())) * inv;
+    let ray = scene.camera.ray(film, sampler.get_2d());
+    (ray, sampler)
+}
+
+/// Adds a sample's radiance to a pixel's sums (RGB and squared luminance), or counts it in
+/// `bad` if it is not finite.
+fn add_sample(sum: &mut [f64; CHANNELS], l: Rgb, bad: &mut u64) {
+    if l.is_finite() {
+        let (r, g, b) = (l.x as f64, l.y as f64, l.z as f64);
+        sum[0] += r;
+        sum[1] += g;
+        sum[2] += b;
+        sum[3] += luminance(r, g, b).powi(2);
+    } else {
+        *bad += 1;
+    }
 }
 
 /// Renders `scene` with its settings, whole, in passes of [`DEFAULT_PASS_SAMPLES`]: a thin
@@ -223,4 +276,76 @@ pub fn render_until(scene: &Scene, progress: &(dyn Fn(u64) + Sync), cancel: &Ato
     }
     let seconds = start.elapsed().as_secs_f64();
     Some(RenderOutput { width: s.width, height: s.height, pixels: film.resolve(), variance: film.variance(), counters: film.counters, nonfinite_samples: film.nonfinite_samples, seconds })
+}
+
+#[cfg(test)]
+mod tests {
+    use raylab_accel::{AccelKind, BuildOptions};
+    use raylab_core::{Rgb, Transform, Vec3};
+
+    use super::*;
+    use crate::integrator::IntegratorKind;
+    use crate::light::Light;
+    use crate::material::{Material, TexColor};
+    use crate::shape::{Sphere, TriangleMesh};
+    use crate::{Camera, RenderSettings};
+
+    /// A wavy 24 × 24 height field (1,152 triangles), a mirror sphere, an emitting sphere and a
+    /// point light: camera rays hit triangles, spheres (not in triangle blocks) and nothing.
+    fn scene(integrator: IntegratorKind, accel: AccelKind) -> Scene {
+        let camera = Camera::new(Vec3::new(0.0, 2.0, 3.5), Vec3::ZERO, Vec3::Y, 50.0, 1.0, 0.0, None).unwrap();
+        let settings = RenderSettings { width: 29, height: 21, spp: 3, max_depth: 4, integrator, accel, ..Default::default() };
+        let mut scene = Scene::new(camera, settings);
+        let ground = scene.add_material("ground", Material::Diffuse { albedo: TexColor::Constant(Rgb::new(0.7, 0.6, 0.5)) });
+        let mirror = scene.add_material("mirror", Material::Mirror { reflectance: TexColor::Constant(Rgb::splat(0.9)) });
+        let n = 24u32;
+        let p = |i: u32, j: u32| {
+            let (x, z) = (i as f32 / n as f32 * 3.0 - 1.5, j as f32 / n as f32 * 3.0 - 1.5);
+            Vec3::new(x, 0.15 * (3.0 * x).sin() * (2.0 * z).cos(), z)
+        };
+        let positions = (0..=n).flat_map(|j| (0..=n).map(move |i| p(i, j))).collect();
+        let v = |i: u32, j: u32| j * (n + 1) + i;
+        let indices = (0..n).flat_map(|j| (0..n).flat_map(move |i| [[v(i, j), v(i, j + 1), v(i + 1, j)], [v(i + 1, j), v(i, j + 1), v(i + 1, j + 1)]])).collect();
+        scene.geometry.add_mesh(TriangleMesh { name: "ground".into(), positions, indices, material: ground, ..Default::default() });
+        scene.geometry.add_sphere(Sphere { center: Vec3::new(0.3, 0.5, 0.0), radius: 0.4, to_world: Transform::IDENTITY, material: mirror, emission: Rgb::ZERO });
+        scene.geometry.add_sphere(Sphere { center: Vec3::new(-0.8, 1.2, -0.5), radius: 0.2, to_world: Transform::IDENTITY, material: ground, emission: Rgb::splat(8.0) });
+        scene.lights.push(Light::Point { position: Vec3::new(1.0, 3.0, 1.0), intensity: Rgb::splat(10.0) });
+        scene.build_accel(&BuildOptions::default());
+        scene
+    }
+
+    /// Camera rays traced in packets give the pixels of camera rays traced one by one, bit for
+    /// bit, on a tile whose 4 × 4 blocks are cut at its right and bottom edges.
+    #[test]
+    fn packets_give_the_single_ray_sums() {
+        let tile = (2, 1, 29, 20);
+        for integrator in [IntegratorKind::Path, IntegratorKind::Whitted, IntegratorKind::Direct, IntegratorKind::Albedo, IntegratorKind::Normals, IntegratorKind::Depth] {
+            for accel in [AccelKind::Bvh8, AccelKind::Bvh4, AccelKind::Bvh8Q] {
+                let scene = scene(integrator, accel);
+                assert!(scene.accel().has_packets() && integrator.traces_ahead());
+                let (mut c1, mut c16, mut bad1, mut bad16) = (Counters::default(), Counters::default(), 0, 0);
+                let single = tile_sums(&scene, tile, 0..3, &mut c1, &mut bad1);
+                let packets = tile_sums_packets(&scene, tile, 0..3, &mut c16, &mut bad16);
+                assert_eq!(single.len(), 27 * 19);
+                let bits = |px: &[[f64; CHANNELS]]| px.iter().flat_map(|p| p.map(f64::to_bits)).collect::<Vec<_>>();
+                assert_eq!(bits(&packets), bits(&single), "{integrator}/{accel}");
+                assert_eq!((bad16, bad1), (0, 0));
+                // The same rays (camera rays and every later one), the camera rays' nodes
+                // counted in packets instead.
+                assert_eq!(c16.rays, c1.rays, "{integrator}/{accel}");
+                assert!(c16.rays >= 3 * 27 * 19 && c16.nodes_visited > 0, "{integrator}/{accel}");
+                // Not a blank image: hits of every kind took part.
+                let lit = single.iter().filter(|p| p[0] > 0.0).count();
+                assert!(lit > single.len() / 4, "{integrator}/{accel}: {lit} pixels lit");
+            }
+        }
+    }
+
+    /// Heat maps show a single ray's own traversal cost, so they never use packets; other
+    /// structures trace camera rays one by one.
+    #[test]
+    fn packets_only_where_they_apply() {
+        assert!(!IntegratorKind::Heatmap.traces_ahead() && !IntegratorKind::HeatmapTests.traces_ahead());
+        assert!(!scene(IntegratorKind::Path, AccelKind::Bvh).accel().has_packets());
+    }
 }

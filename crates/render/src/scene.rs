@@ -1,4 +1,4 @@
-use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Primitives};
+use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Hit, Primitives};
 use raylab_core::{offset_ray_origin, Ray, Rgb, Vec3};
 
 use crate::camera::Camera;
@@ -106,12 +106,29 @@ impl Scene {
     pub fn intersect(&self, ray: &Ray, counters: &mut Counters) -> Option<SurfaceHit> {
         debug_assert_eq!(self.accel.stats().primitives, self.geometry.len(), "build_accel() after adding geometry");
         let h = self.accel.intersect(&self.geometry, ray, counters)?;
+        Some(self.surface_hit(ray, &h))
+    }
+
+    /// Closest hits of a packet of camera rays (at most [`raylab_accel::PACKET`]): the same
+    /// answers as [`Scene::intersect`] ray by ray, traversed together by wide BVHs.
+    pub fn intersect_packet(&self, rays: &[Ray], out: &mut [Option<SurfaceHit>], counters: &mut Counters) {
+        debug_assert_eq!(self.accel.stats().primitives, self.geometry.len(), "build_accel() after adding geometry");
+        let mut hits = [None; raylab_accel::PACKET];
+        let hits = &mut hits[..rays.len()];
+        self.accel.intersect_packet_counted(&self.geometry, rays, hits, counters);
+        for ((o, h), ray) in out.iter_mut().zip(hits.iter()).zip(rays) {
+            *o = h.as_ref().map(|h| self.surface_hit(ray, h));
+        }
+    }
+
+    /// The surface record of `h`, a hit of `ray`: geometry, shading normal, material.
+    fn surface_hit(&self, ray: &Ray, h: &Hit) -> SurfaceHit {
         let material = self.geometry.material(h.prim);
         let mut geom = self.geometry.surface(ray, h.prim, h.t, h.u, h.v);
         if let Some(p) = &self.material_perturbations[material.0 as usize] {
             geom.ns = p.shading_normal(&self.textures, &self.geometry, h.prim, h.u, h.v, &geom);
         }
-        Some(SurfaceHit { t: h.t, prim: h.prim, geom, material })
+        SurfaceHit { t: h.t, prim: h.prim, geom, material }
     }
 
     pub fn occluded(&self, ray: &Ray, counters: &mut Counters) -> bool {

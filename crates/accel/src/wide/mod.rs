@@ -127,16 +127,26 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
     /// # Panics
     /// If `rays` holds more than [`PACKET`] rays or `out` is not as long as `rays`.
     pub fn intersect_packet<P: Primitives + ?Sized>(&self, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
+        self.packet_dispatch::<P, false>(prims, rays, out, &mut Counters::default())
+    }
+
+    /// [`WideBvh::intersect_packet`], counting (the renderer's camera rays).
+    pub fn intersect_packet_counted<P: Primitives + ?Sized>(&self, prims: &P, rays: &[Ray], out: &mut [Option<Hit>], c: &mut Counters) {
+        self.packet_dispatch::<P, true>(prims, rays, out, c)
+    }
+
+    #[inline]
+    fn packet_dispatch<P: Primitives + ?Sized, const COUNT: bool>(&self, prims: &P, rays: &[Ray], out: &mut [Option<Hit>], c: &mut Counters) {
         #[cfg(target_arch = "x86_64")]
         match self.kernel {
             // SAFETY: `Kernel::Avx512` is only chosen after detecting its features.
-            Kernel::Avx512 => return unsafe { packet_avx512::<P, W, N>(self, prims, rays, out) },
+            Kernel::Avx512 => return unsafe { packet_avx512::<P, W, N, COUNT>(self, prims, rays, out, c) },
             // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
-            Kernel::Simd if W == 8 => return unsafe { packet_avx2::<P, W, N>(self, prims, rays, out) },
-            Kernel::Simd => return packet::closest::<P, W, N, true>(self, prims, rays, out),
+            Kernel::Simd if W == 8 => return unsafe { packet_avx2::<P, W, N, COUNT>(self, prims, rays, out, c) },
+            Kernel::Simd => return packet::closest::<P, W, N, true, COUNT>(self, prims, rays, out, c),
             Kernel::Portable => {}
         }
-        packet::closest::<P, W, N, false>(self, prims, rays, out)
+        packet::closest::<P, W, N, false, COUNT>(self, prims, rays, out, c)
     }
 
     #[inline]
@@ -232,8 +242,8 @@ unsafe fn closest_avx2<P: Primitives + ?Sized, const W: usize, N: Layout<W>, con
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn packet_avx2<P: Primitives + ?Sized, const W: usize, N: Layout<W>>(bvh: &WideBvh<W, N>, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
-    packet::closest::<P, W, N, true>(bvh, prims, rays, out)
+unsafe fn packet_avx2<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, rays: &[Ray], out: &mut [Option<Hit>], c: &mut Counters) {
+    packet::closest::<P, W, N, true, COUNT>(bvh, prims, rays, out, c)
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -252,8 +262,8 @@ unsafe fn closest_avx512<P: Primitives + ?Sized, const W: usize, N: Layout<W>, c
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,avx512f,avx512vl,bmi1,bmi2")]
-unsafe fn packet_avx512<P: Primitives + ?Sized, const W: usize, N: Layout<W>>(bvh: &WideBvh<W, N>, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
-    packet::closest::<P, W, N, true>(bvh, prims, rays, out)
+unsafe fn packet_avx512<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, rays: &[Ray], out: &mut [Option<Hit>], c: &mut Counters) {
+    packet::closest::<P, W, N, true, COUNT>(bvh, prims, rays, out, c)
 }
 
 #[cfg(target_arch = "x86_64")]

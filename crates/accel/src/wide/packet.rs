@@ -18,9 +18,9 @@ use raylab_core::Ray;
 use super::kernels::slabs_avx2;
 use super::kernels::{RayBoxes, ROBUST_FAR};
 use super::node::{is_leaf, ChildRef, Layout, WideNode, EMPTY};
-use super::traverse::{block_closest, child_boxes, leaf_slice, STACK};
+use super::traverse::{block_closest, child_boxes, leaf_slice, occupied, STACK};
 use super::WideBvh;
-use crate::{Hit, Primitives};
+use crate::{Counters, Hit, Primitives};
 
 /// Rays per packet: a 4×4 tile, one bit each in a [`RayMask`].
 pub const PACKET: usize = 16;
@@ -105,12 +105,18 @@ unsafe fn node_boxes_avx2(node: &WideNode<8>, rb: &[RayBoxes; PACKET], far: &[f3
     _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(rays, _mm256_setzero_si256()))) as u32
 }
 
-/// Closest hits of `rays` (at most [`PACKET`]) into `out` (as long as `rays`).
+/// Closest hits of `rays` (at most [`PACKET`]) into `out` (as long as `rays`). The counting
+/// build (`COUNT`) charges each ray the nodes it is active in and the occupied triangle
+/// lanes it tests: a node loaded once for the packet counts once per ray that needed it,
+/// as it would alone.
 #[inline(always)]
-pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SIMD: bool>(bvh: &WideBvh<W, N>, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
+pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SIMD: bool, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, rays: &[Ray], out: &mut [Option<Hit>], c: &mut Counters) {
     let n = rays.len();
     assert!(n <= PACKET && out.len() == n, "a packet holds at most {PACKET} rays and as many answers");
     out.fill(None);
+    if COUNT {
+        c.rays += n as u64;
+    }
     if bvh.root == EMPTY || n == 0 {
         return;
     }
@@ -125,8 +131,14 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
     let mut cur = bvh.root;
     let mut active: RayMask = (1 << n) - 1;
     'walk: loop {
+        if COUNT {
+            c.nodes_visited += u64::from(active.count_ones());
+        }
         if is_leaf(cur) {
             for b in leaf_slice(bvh, cur) {
+                if COUNT {
+                    c.prim_tests += occupied(b) * u64::from(active.count_ones());
+                }
                 for r in bits(active) {
                     block_closest::<P, SIMD>(b, prims, &sheared[r], &mut ray[r], &mut out[r]);
                     far[r] = ray[r].t_max * ROBUST_FAR;

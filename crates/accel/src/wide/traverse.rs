@@ -139,7 +139,7 @@ fn exact_lane<P: Primitives + ?Sized>(b: &TriBlock, l: usize, prims: &P, s: &She
 
 /// Occupied lanes of a block (what the counting build charges as primitive tests).
 #[inline(always)]
-fn occupied(b: &TriBlock) -> u64 {
+pub(super) fn occupied(b: &TriBlock) -> u64 {
     b.prim.iter().filter(|&&p| p != EMPTY).count() as u64
 }
 

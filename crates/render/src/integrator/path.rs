@@ -46,7 +46,7 @@ fn shading_frame(hit: &SurfaceHit, bsdf: &Bsdf, wo: Vec3) -> Frame {
     }
 }
 
-pub(super) fn radiance(scene: &Scene, camera_ray: &Ray, sampler: &mut PixelSampler, c: &mut Counters, direct_only: bool) -> Rgb {
+pub(super) fn radiance(scene: &Scene, camera_ray: &Ray, mut first: Option<Option<SurfaceHit>>, sampler: &mut PixelSampler, c: &mut Counters, direct_only: bool) -> Rgb {
     let s = &scene.settings;
     let strategy = s.light_sampling;
     let mut l = Rgb::ZERO;
@@ -57,7 +57,7 @@ pub(super) fn radiance(scene: &Scene, camera_ray: &Ray, sampler: &mut PixelSampl
     let mut prev_pdf = 0.0f32;
     let mut prev_p = ray.origin;
     for depth in 1..=s.max_depth {
-        let Some(hit) = scene.intersect(&ray, c) else {
+        let Some(hit) = first.take().unwrap_or_else(|| scene.intersect(&ray, c)) else {
             l += beta * scene.background(ray.dir) * environment_weight(scene, specular, prev_pdf, ray.dir);
             break;
         };

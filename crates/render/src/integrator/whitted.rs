@@ -15,8 +15,8 @@ use crate::material::Material;
 use crate::scene::SurfaceHit;
 use crate::Scene;
 
-pub(super) fn radiance(scene: &Scene, ray: &Ray, depth: u32, sampler: &mut PixelSampler, c: &mut Counters) -> Rgb {
-    let Some(hit) = scene.intersect(ray, c) else {
+pub(super) fn radiance(scene: &Scene, ray: &Ray, first: Option<Option<SurfaceHit>>, depth: u32, sampler: &mut PixelSampler, c: &mut Counters) -> Rgb {
+    let Some(hit) = first.unwrap_or_else(|| scene.intersect(ray, c)) else {
         return scene.background(ray.dir);
     };
     let wo = -ray.dir.normalize();
@@ -60,7 +60,7 @@ pub(super) fn radiance(scene: &Scene, ray: &Ray, depth: u32, sampler: &mut Pixel
         Material::Mirror { reflectance } => {
             let n = facing(g.ns, wo);
             let r = reflectance.eval(tex, g.uv, g.p);
-            r * radiance(scene, &hit.spawn(reflect(wo, n)), depth + 1, sampler, c)
+            r * radiance(scene, &hit.spawn(reflect(wo, n)), None, depth + 1, sampler, c)
         }
         Material::Dielectric { ior } => {
             // Which side are we on? The geometric normal decides; the shading normal bends.
@@ -68,10 +68,10 @@ pub(super) fn radiance(scene: &Scene, ray: &Ray, depth: u32, sampler: &mut Pixel
             let n = if entering { g.ns } else { -g.ns };
             let eta = if entering { *ior } else { 1.0 / *ior };
             let f = fresnel_dielectric(wo.dot(n).clamp(-1.0, 1.0), eta);
-            let mut l = f * radiance(scene, &hit.spawn(reflect(wo, n)), depth + 1, sampler, c);
+            let mut l = f * radiance(scene, &hit.spawn(reflect(wo, n)), None, depth + 1, sampler, c);
             if f < 1.0 {
                 if let Some(wt) = refract(wo, n, eta) {
-                    l += (1.0 - f) * radiance(scene, &hit.spawn(wt), depth + 1, sampler, c);
+                    l += (1.0 - f) * radiance(scene, &hit.spawn(wt), None, depth + 1, sampler, c);
                 }
             }
             l
