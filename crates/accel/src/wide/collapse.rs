@@ -1,10 +1,13 @@
-//! Binary tree → `W`-wide tree, after Embree's BVH-N builders (Wald et al. 2008, "Getting
-//! rid of packets"; Benthin et al. 2012): each wide node starts from a binary node's two
-//! children and repeatedly opens the child of largest surface area — the one a ray is most
-//! likely to enter, so the one whose node visit is worth saving by the SAH — until `W`
-//! children are reached or none can be opened. Subtrees of at most [`LEAF_PRIMS`]
-//! references become one leaf (one block of four triangles), so leaves are full SIMD
-//! blocks instead of the binary builders' 1-2 triangles.
+//! Binary tree → `W`-wide tree by a cost-driven collapse (after Ylitie, Karras & Laine 2017,
+//! "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", §4.1): a
+//! dynamic programme over the binary tree chooses, for every subtree, whether it becomes a
+//! leaf (one or more blocks of four triangles), one wide node, or is spread over several of
+//! its parent's `W` slots, so as to minimise the SAH cost the statistics report: each wide
+//! node charged its surface area, each leaf its area times its blocks (the units the
+//! traversal tests), relative to the root. Embree's greedy rule (open the child of largest
+//! area until `W` children) is one of the trees it considers, so the cost never rises.
+//! Subtrees of at most [`LEAF_PRIMS`] references may become leaves (two blocks); binary
+//! leaves always do.
 
 use raylab_core::Aabb;
 
@@ -12,8 +15,8 @@ use super::node::{leaf_ref, ChildRef, TriBlock, WideNode, MAX_BLOCKS, MAX_LEAF_B
 use crate::bvh::{Bvh, BvhNode};
 use crate::Primitives;
 
-/// Subtrees with at most this many references become a single leaf: one [`TriBlock`].
-pub const LEAF_PRIMS: usize = 4;
+/// Subtrees with at most this many references may become a single leaf (two [`TriBlock`]s).
+pub const LEAF_PRIMS: usize = 8;
 
 pub(super) struct Collapsed<const W: usize> {
     pub nodes: Vec<WideNode<W>>,
@@ -28,6 +31,8 @@ struct Ctx<'a, P: ?Sized, const W: usize> {
     prims: &'a P,
     /// References below each binary node.
     counts: Vec<usize>,
+    /// The dynamic programme's choices per binary node (see [`plan`]).
+    plan: Vec<Plan<W>>,
     nodes: Vec<WideNode<W>>,
     blocks: Vec<TriBlock>,
 }
@@ -45,17 +50,75 @@ pub(super) fn collapse<P: Primitives + ?Sized, const W: usize>(bvh: &Bvh, prims:
         let n = &bin[i];
         counts[i] = if n.is_leaf() { n.count as usize } else { counts[n.left_first as usize] + counts[n.left_first as usize + 1] };
     }
-    let mut ctx = Ctx { bin, indices: &bvh.indices, prims, counts, nodes: Vec::with_capacity(bin.len() / W + 1), blocks: Vec::with_capacity(prims.len() / 2 + 1) };
+    let plan = plan::<W>(bin, &counts);
+    let mut ctx = Ctx { bin, indices: &bvh.indices, prims, counts, plan, nodes: Vec::with_capacity(bin.len() / W + 1), blocks: Vec::with_capacity(prims.len() / 2 + 1) };
     let root = ctx.child(0);
     assert!(ctx.blocks.len() <= MAX_BLOCKS, "wide BVH: too many triangle blocks");
     Collapsed { nodes: ctx.nodes, blocks: ctx.blocks, root, root_bounds: bin[0].bounds() }
 }
 
+/// What the dynamic programme chose for one binary node.
+#[derive(Clone, Copy)]
+struct Plan<const W: usize> {
+    /// Whole, as one slot of its parent: a leaf (else a wide node).
+    leaf: bool,
+    /// `split[j - 1]`, for at most `j` slots: 0 to keep the subtree whole in one slot, else
+    /// `k`, the slots its left child spreads over (the right child takes `j - k`). For
+    /// `j = W` and an interior node, `wide[..]` below is what its own wide node holds.
+    split: [u8; W],
+    /// When whole and not a leaf: the left child's share of the wide node's `W` slots.
+    wide: u8,
+}
+
+/// The dynamic programme, children before parents (a reverse sweep: children always sit
+/// after their parent). `cost[j - 1]` is the least cost of a subtree spread over at most `j`
+/// slots of its parent; a wide node costs its area, a leaf its area times its blocks.
+fn plan<const W: usize>(bin: &[BvhNode], counts: &[usize]) -> Vec<Plan<W>> {
+    let mut cost = vec![[0.0f32; W]; bin.len()];
+    let mut plan = vec![Plan { leaf: true, split: [0; W], wide: 0 }; bin.len()];
+    for i in (0..bin.len()).rev() {
+        let n = &bin[i];
+        let area = n.bounds().half_area().max(0.0);
+        let as_leaf = area * counts[i].div_ceil(4) as f32;
+        if n.is_leaf() {
+            cost[i] = [as_leaf; W];
+            continue;
+        }
+        let (l, r) = (n.left_first as usize, n.left_first as usize + 1);
+        // spread[j - 1]: both children over at most j slots (j ≥ 2), and the left's share.
+        let mut spread = [(f32::INFINITY, 0u8); W];
+        for j in 2..=W {
+            for k in 1..j {
+                let c = cost[l][k - 1] + cost[r][j - k - 1];
+                if c < spread[j - 1].0 {
+                    spread[j - 1] = (c, k as u8);
+                }
+            }
+        }
+        let as_node = area + spread[W - 1].0;
+        let leaf = counts[i] <= LEAF_PRIMS && as_leaf <= as_node;
+        let whole = if leaf { as_leaf } else { as_node };
+        let mut p = Plan { leaf, split: [0; W], wide: spread[W - 1].1 };
+        cost[i][0] = whole;
+        for j in 2..=W {
+            let (c, k) = spread[j - 1];
+            if c < whole {
+                cost[i][j - 1] = c;
+                p.split[j - 1] = k;
+            } else {
+                cost[i][j - 1] = whole;
+            }
+        }
+        plan[i] = p;
+    }
+    plan
+}
+
 impl<P: Primitives + ?Sized, const W: usize> Ctx<'_, P, W> {
-    /// The reference for binary node `i`: a leaf if it is small enough, a wide node else.
+    /// The reference for binary node `i`, whole: a leaf or a wide node, as planned.
     fn child(&mut self, i: usize) -> ChildRef {
         let n = &self.bin[i];
-        if n.is_leaf() || self.counts[i] <= LEAF_PRIMS {
+        if n.is_leaf() || self.plan[i].leaf {
             let mut refs = Vec::with_capacity(self.counts[i]);
             self.gather(i, &mut refs);
             // Spatial splits may put one primitive in two leaves of a merged subtree.
@@ -63,19 +126,11 @@ impl<P: Primitives + ?Sized, const W: usize> Ctx<'_, P, W> {
             refs.dedup();
             return self.leaf(&refs, n.bounds());
         }
-        let mut open: Vec<usize> = vec![n.left_first as usize, n.left_first as usize + 1];
-        while open.len() < W {
-            let best = open
-                .iter()
-                .enumerate()
-                .filter(|&(_, &c)| !self.bin[c].is_leaf() && self.counts[c] > LEAF_PRIMS)
-                .max_by(|a, b| self.bin[*a.1].bounds().half_area().total_cmp(&self.bin[*b.1].bounds().half_area()))
-                .map(|(k, _)| k);
-            let Some(k) = best else { break };
-            let c = open.swap_remove(k);
-            let l = self.bin[c].left_first as usize;
-            open.extend([l, l + 1]);
-        }
+        let l = n.left_first as usize;
+        let k = self.plan[i].wide as usize;
+        let mut open = Vec::with_capacity(W);
+        self.slots(l, k, &mut open);
+        self.slots(l + 1, W - k, &mut open);
         let slot = self.nodes.len();
         self.nodes.push(WideNode::EMPTY_NODE);
         for (lane, &c) in open.iter().enumerate() {
@@ -84,6 +139,18 @@ impl<P: Primitives + ?Sized, const W: usize> Ctx<'_, P, W> {
             self.nodes[slot].set(lane, &b, r);
         }
         slot as ChildRef
+    }
+
+    /// The binary nodes that subtree `i` puts in at most `j` slots of its parent.
+    fn slots(&self, i: usize, j: usize, out: &mut Vec<usize>) {
+        match self.plan[i].split[j - 1] {
+            0 => out.push(i),
+            k => {
+                let l = self.bin[i].left_first as usize;
+                self.slots(l, k as usize, out);
+                self.slots(l + 1, j - k as usize, out);
+            }
+        }
     }
 
     fn gather(&self, i: usize, out: &mut Vec<u32>) {
@@ -124,5 +191,62 @@ impl<P: Primitives + ?Sized, const W: usize> Ctx<'_, P, W> {
             self.nodes[slot].set(lane, &cb, r);
         }
         slot as ChildRef
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use raylab_core::{Aabb, Vec3};
+
+    use super::*;
+
+    fn aabb(x: f32, y: f32, z: f32) -> Aabb {
+        Aabb::new(Vec3::ZERO, Vec3::new(x, y, z))
+    }
+
+    fn counts(bin: &[BvhNode]) -> Vec<usize> {
+        let mut c = vec![0; bin.len()];
+        for i in (0..bin.len()).rev() {
+            let n = &bin[i];
+            c[i] = if n.is_leaf() { n.count as usize } else { c[n.left_first as usize] + c[n.left_first as usize + 1] };
+        }
+        c
+    }
+
+    /// Two leaves of three filling their parent's box: as one leaf of two blocks the parent
+    /// costs 3 · 2 = 6 (half area 3 of the unit cube, two blocks); as a wide node over two
+    /// one-block leaves 3 + 3 + 3 = 9. The greedy rule (leaves of at most four) took the node.
+    #[test]
+    fn six_triangles_in_one_box_make_one_leaf() {
+        let bin = [BvhNode::interior(aabb(1.0, 1.0, 1.0), 1), BvhNode::leaf(aabb(1.0, 1.0, 1.0), 0, 3), BvhNode::leaf(aabb(1.0, 1.0, 1.0), 3, 3)];
+        assert!(plan::<8>(&bin, &counts(&bin))[0].leaf);
+        // Small children, half area 0.25 each (0.5 × 0.5 × 0): as a node 3 + 0.25 + 0.25 = 3.5 < 6.
+        let bin = [BvhNode::interior(aabb(1.0, 1.0, 1.0), 1), BvhNode::leaf(aabb(0.5, 0.5, 0.0), 0, 3), BvhNode::leaf(aabb(0.5, 0.5, 0.0), 3, 3)];
+        assert!(!plan::<8>(&bin, &counts(&bin))[0].leaf);
+    }
+
+    /// Root R (half area 3) over A (interior, half area 2, over two leaves of eight, half area
+    /// 1 and two blocks each, so 2 each) and B (a leaf of four, half area 1: cost 1), 4 wide.
+    /// A kept whole costs 2 + 2 + 2 = 6 in one slot; spread over two slots 4. R's node: A in
+    /// one slot 6 + 1, in two slots 4 + 1 = 5 (three slots gain nothing): A's leaves go up
+    /// into R's node, and R costs 3 + 5 = 8.
+    #[test]
+    fn a_child_is_spread_over_its_parents_slots_when_cheaper() {
+        let bin = [
+            BvhNode::interior(aabb(1.0, 1.0, 1.0), 1),
+            BvhNode::interior(aabb(1.0, 1.0, 0.5), 3),
+            BvhNode::leaf(aabb(0.5, 0.5, 0.75), 0, 4),
+            BvhNode::leaf(aabb(0.5, 0.5, 0.75), 4, 8),
+            BvhNode::leaf(aabb(0.5, 0.5, 0.75), 12, 8),
+        ];
+        for (i, want) in [3.0, 2.0, 1.0, 1.0, 1.0].into_iter().enumerate() {
+            assert_eq!(bin[i].bounds().half_area(), want, "node {i}");
+        }
+        let plan = plan::<4>(&bin, &counts(&bin));
+        assert!(!plan[0].leaf && !plan[1].leaf, "20 and 16 references are too many for a leaf");
+        assert_eq!(plan[0].wide, 2, "A takes two of R's four slots");
+        assert_eq!(plan[1].split[1], 1, "A over two slots: one for each of its leaves");
+        assert_eq!(plan[1].split[0], 0, "A in one slot stays whole");
+        assert_eq!(plan[1].wide, 1);
     }
 }
