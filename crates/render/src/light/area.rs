@@ -428,6 +428,18 @@ mod tests {
     }
 
     #[test]
+    fn a_scene_without_emitters_has_no_area_lights() {
+        // Only the dark triangle: nothing to choose, no sample, no density.
+        let mut g = Geometry::default();
+        g.add_mesh(TriangleMesh { name: "dark".into(), positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y], indices: vec![[0, 1, 2]], ..Default::default() });
+        let lights = AreaLights::new(&g, 4);
+        assert!(lights.is_empty());
+        assert_eq!(lights.len(), 0);
+        assert!(lights.sample(&g, &[], Vec3::new(0.2, 0.2, 1.0), &|_| 1.0, LightSampling::Uniform, 0.5, Vec2::splat(0.5)).is_none());
+        assert_eq!(lights.pdf(&g, LightSampling::Uniform, 0, Vec3::new(0.2, 0.2, 1.0), Vec3::new(0.2, 0.2, 0.0), Vec3::Z), 0.0);
+    }
+
+    #[test]
     fn samples_pick_emitters_by_the_cdf_and_report_their_density() {
         let g = scene();
         let lights = AreaLights::new(&g, 4);
