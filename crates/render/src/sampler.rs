@@ -424,6 +424,25 @@ mod tests {
     }
 
     #[test]
+    fn dimension_hashes_are_one_to_one() {
+        // For a fixed dimension d the hash is a bijection of the pixel's hash (xor with d·φ,
+        // φ = 0x9e37_79b9_7f4a_7c15 odd, then mix64), so two pixels never share a dimension's
+        // shuffle and scramble: pixel hashes 0 and φ differ at dimension 1 too (0 ^ φ and
+        // φ ^ φ = 0; an `|` would take both to φ).
+        let sampler = |pixel_hash| PixelSampler { kind: SamplerKind::Sobol, spp: 16, index: 0, dim: 0, pixel_hash, rng: Pcg32::new(0, 0) };
+        let (mut a, mut b) = (sampler(0), sampler(0x9e37_79b9_7f4a_7c15));
+        for d in 0..64 {
+            assert_ne!(a.dimension_hash(), b.dimension_hash(), "dimension {d}");
+        }
+        // For a fixed pixel, d ↦ d·φ is one-to-one mod 2⁶⁴: 1000 dimensions, 1000 hashes.
+        let mut s = sampler(0x1234_5678_9abc_def0);
+        let mut seen = std::collections::HashSet::new();
+        for d in 0..1000 {
+            assert!(seen.insert(s.dimension_hash()), "dimension {d}");
+        }
+    }
+
+    #[test]
     fn the_pixel_position_is_the_first_stratified_pair() {
         // Jittered with 4 samples: one film position in each quadrant of the pixel, and the
         // same values as the first get_2d of an identical sampler.
@@ -477,8 +496,9 @@ mod tests {
         // Any permutation keeps the strata, so only the published function can tell a changed
         // shift or mask apart; the images' reproducibility depends on it. Powers of two (the
         // mask exactly n − 1, no cycle walk) and not, and seeds with every shifted part set.
-        // Indices past n wrap (i mod n) before the walk.
-        for n in [2u32, 3, 5, 16, 17, 64, 100, 1000] {
+        // Indices past n wrap (i mod n) before the walk. The step `(i & w) >> 11` is 0 below
+        // n = 2¹¹ + 1, hence 4096 and 5000.
+        for n in [2u32, 3, 5, 16, 17, 64, 100, 1000, 4096, 5000] {
             for p in [0u32, 1, 0x8000_0001, 0xdead_beef, 0x1234_5678, 0xffff_ffff] {
                 for i in 0..n {
                     assert_eq!(permutation_element(i, n, p), kensler_permute(i, n, p), "i {i}, n {n}, p {p:#x}");
