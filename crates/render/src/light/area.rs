@@ -787,6 +787,20 @@ mod tests {
     }
 
     #[test]
+    fn from_the_spheres_surface_densities_are_the_area_ones() {
+        // p = (0, 0, 1) on the radius-1 sphere at (0, 0, 2): d² = r² exactly, where `sample`
+        // falls back to area sampling, so `pdf` must too: towards the far point (0, 0, 3),
+        // 1/(4π)·d²/cos = 4/(4π) = 1/π, not the cone's 1/(2π(1 − cos θmax)) = 1/(2π) (θmax = 90°).
+        let mut g = Geometry::default();
+        g.add_sphere(Sphere { center: Vec3::new(0.0, 0.0, 2.0), radius: 1.0, to_world: Transform::IDENTITY, material: Default::default(), emission: Rgb::ONE });
+        let lights = AreaLights::new(&g, 2);
+        for strategy in [LightSampling::SolidAngle, LightSampling::Mis, LightSampling::Uniform] {
+            let p = lights.pdf(&g, strategy, 0, Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 0.0, 3.0), Vec3::Z);
+            assert!(close(p, 1.0 / std::f64::consts::PI, 1e-6), "{strategy:?}: {p}");
+        }
+    }
+
+    #[test]
     fn tiny_caps_hit_the_sampled_angle_precisely() {
         // Radius 0.01 at distance 1 (sin²θmax = 10⁻⁴): the direction's sin²θ must be 10⁻⁴·u.x
         // to f32 precision (10⁻⁵ relative here), not just to the 2·10⁻³ of the test below: a
