@@ -679,6 +679,12 @@ mod tests {
             let p = lights.pdf(&g, LightSampling::SolidAngle, 0, Vec3::ZERO, Vec3::new(0.0, 1.0, 0.0), -Vec3::Y);
             assert!(close(p, 1.0 / omega, 1e-4), "c {c}, d {d}: {p} against {}", 1.0 / omega);
         }
+        // (iii) The same light turned a quarter, e2 = d − a now the longer edge (4), c off by
+        // 3·10⁻⁵: the scale is the longer of the two edges, whichever it is.
+        let mut g = Geometry::default();
+        g.add_mesh(quad([Vec3::new(-1.0, 1.0, -2.0), Vec3::new(1.0, 1.0, -2.0), Vec3::new(1.0 + 3e-5, 1.0, 2.0), Vec3::new(-1.0, 1.0, 2.0)], 1.0));
+        let p = AreaLights::new(&g, 2).pdf(&g, LightSampling::SolidAngle, 0, Vec3::ZERO, Vec3::new(0.0, 1.0, 0.0), -Vec3::Y);
+        assert!(close(p, 1.0 / omega, 1e-4), "e2 the longer edge: {p} against {}", 1.0 / omega);
     }
 
     #[test]
