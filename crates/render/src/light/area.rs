@@ -626,6 +626,21 @@ mod tests {
     }
 
     #[test]
+    fn a_cell_owns_the_start_of_its_cdf_interval() {
+        // Cells invert their CDF half-open, as the emitter choice does (the first CDF value
+        // above u): with a receiver taking nothing, k = 2 cells of ¼ each (sums 0.25, 0.5, 0.75,
+        // exact in f32), u_cell = 2·u_choice exactly 0.25 or 0.5 is the start of cell (1, 0),
+        // centre (0.5, 1, −0.5), or of cell (0, 1), centre (−0.5, 1, 0.5).
+        let mut g = Geometry::default();
+        g.add_mesh(quad(A, 3.0));
+        let lights = AreaLights::new(&g, 2);
+        for (u_choice, centre) in [(0.125f32, Vec3::new(0.5, 1.0, -0.5)), (0.25, Vec3::new(-0.5, 1.0, 0.5))] {
+            let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 0.0, LightSampling::Cells, u_choice, Vec2::splat(0.5)).unwrap();
+            assert!((s.wi * s.dist - centre).length() < 1e-5, "{u_choice}: {} against {centre}", s.wi * s.dist);
+        }
+    }
+
+    #[test]
     fn cells_are_weighed_by_the_emission_texture() {
         // A (radiance 1) with the grey 2 × 2 texture [1, 2 | 3, 4] (row 0 at v > ½), k = 2
         // cells on its texels, from the origin with a receiver taking everything: the four
