@@ -179,7 +179,9 @@ fn permutation_element(mut i: u32, n: u32, p: u32) -> u32 {
             break;
         }
     }
-    (i + p) % n
+    // In 64 bits: `i + p` in u32 (as Kensler prints it) wraps for p > 2³² − 1 − i, where the
+    // result is no longer a permutation (and a debug build panics).
+    ((i as u64 + p as u64) % n as u64) as u32
 }
 
 #[cfg(test)]
@@ -314,6 +316,233 @@ mod tests {
                     assert!((0.0..1.0).contains(&a) && (0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y));
                 }
             }
+        }
+    }
+
+    #[test]
+    fn check_spp_accepts_squares_for_jittered_only() {
+        assert_eq!(SamplerKind::Random.check_spp(0).unwrap_err(), "must be at least 1");
+        assert_eq!(SamplerKind::Jittered.check_spp(0).unwrap_err(), "must be at least 1");
+        // 9 = 3·3 and 16 = 4·4, where n + n (6, 8) and n / n (1) are not the square.
+        for spp in [1, 4, 9, 16, 25, 1024] {
+            assert_eq!(SamplerKind::Jittered.check_spp(spp), Ok(()), "{spp}");
+        }
+        for spp in [2, 3, 8, 15, 17] {
+            assert_eq!(SamplerKind::Jittered.check_spp(spp).unwrap_err(), format!("the jittered sampler needs a square number of samples (1, 4, 9, 16, ...), found {spp}"));
+            assert_eq!(SamplerKind::Random.check_spp(spp), Ok(()));
+            assert_eq!(SamplerKind::Sobol.check_spp(spp), Ok(()));
+        }
+    }
+
+    #[test]
+    fn to_unit_keeps_the_top_24_bits() {
+        // v / 2³² truncated to 24 bits: the low 8 bits are dropped, and the largest value is
+        // (2²⁴ − 1)/2²⁴ = 1 − 2⁻²⁴, exact in f32.
+        assert_eq!(to_unit(0), 0.0);
+        assert_eq!(to_unit(0xff), 0.0);
+        assert_eq!(to_unit(0x100), 2f32.powi(-24));
+        assert_eq!(to_unit(0x8000_0000), 0.5);
+        assert_eq!(to_unit(0xc000_00ff), 0.75);
+        assert_eq!(to_unit(u32::MAX), 1.0 - 2f32.powi(-24));
+    }
+
+    #[test]
+    fn sobol_02_second_dimension_follows_its_direction_numbers() {
+        // v₁ = .1, v₂ = .11, v₃ = .101 (binary; each v_k = v_{k−1} ^ (v_{k−1} >> 1)), y(i) the
+        // xor of v_k over the set bits k of i: y(4) = .101, y(5) = .1 ^ .101 = .001,
+        // y(6) = .11 ^ .101 = .011, y(7) = .1 ^ .11 ^ .101 = .111. x is i's bits mirrored.
+        let p: Vec<(f64, f64)> = (4..8).map(sobol_02).map(|(a, b)| (a as f64 / 2f64.powi(32), b as f64 / 2f64.powi(32))).collect();
+        assert_eq!(p, [(0.125, 0.625), (0.625, 0.125), (0.375, 0.375), (0.875, 0.875)]);
+        // y(2^k) = v_{k+1}, whose bits are row k of Pascal's triangle mod 2: row 4 is 1 0 0 0 1,
+        // row 7 is 1 1 1 1 1 1 1 1.
+        assert_eq!(sobol_02(16).1, 0b10001 << 27);
+        assert_eq!(sobol_02(128).1, 0xff00_0000);
+    }
+
+    #[test]
+    fn owen_scrambling_permutes_every_level_of_nested_intervals() {
+        // An Owen scramble flips each bit of the fraction by a function of the bits above it:
+        // the top k bits of the result depend only on the top k bits of the input, and map
+        // the 2^k intervals of length 2⁻ᵏ one-to-one onto themselves.
+        let mut rng = Pcg32::new(5, 9);
+        for _ in 0..40 {
+            let seed = rng.next_u32();
+            for k in 1..=8u32 {
+                let mut seen = vec![false; 1 << k];
+                for top in 0..1u32 << k {
+                    let v = top << (32 - k);
+                    let out = owen_scramble(v, seed) >> (32 - k);
+                    assert!(!std::mem::replace(&mut seen[out as usize], true), "seed {seed:#x}, {k} bits: {top} and another both to {out}");
+                    let low = rng.next_u32() >> k;
+                    assert_eq!(owen_scramble(v | low, seed) >> (32 - k), out, "seed {seed:#x}: lower bits changed the top {k}");
+                }
+            }
+        }
+        // The seed decides the flips: the first bit of 0's image is 1 for about half the seeds.
+        let ones = (0..1000).filter(|_| owen_scramble(0, rng.next_u32()) >> 31 == 1).count();
+        assert!((400..600).contains(&ones), "{ones} of 1000");
+    }
+
+    /// Sorted values of one coordinate of dimension `dim` over a pixel's `spp` samples.
+    fn sorted(kind: SamplerKind, spp: u32, x: u32, dim: usize, coord: usize) -> Vec<f32> {
+        let mut v: Vec<f32> = points(kind, spp, x, dim + 1).iter().map(|p| if coord == 0 { p[dim].x } else { p[dim].y }).collect();
+        v.sort_by(f32::total_cmp);
+        v
+    }
+
+    #[test]
+    fn sobol_values_are_scrambled_per_pixel_and_dimension() {
+        // With 16 samples each coordinate has one value in each sixteenth ((0,4,1)-net), but
+        // where in it depends on the pixel's and dimension's scramble: the sorted values of
+        // two pixels (or of two dimensions) are not the same.
+        for coord in 0..2 {
+            let (a, b, c) = (sorted(SamplerKind::Sobol, 16, 1, 0, coord), sorted(SamplerKind::Sobol, 16, 2, 0, coord), sorted(SamplerKind::Sobol, 16, 1, 1, coord));
+            for v in [&a, &b, &c] {
+                assert!(v.iter().enumerate().all(|(i, &x)| (x * 16.0) as usize == i), "{coord}: {v:?}");
+            }
+            assert!(a != b && a != c, "coordinate {coord}: {a:?} {b:?} {c:?}");
+        }
+        // The same for 1D values (dimension 0 of two pixels, or dimensions 0 and 1).
+        let one_d = |x: u32, dim: usize| {
+            let mut v: Vec<f32> = (0..16)
+                .map(|i| {
+                    let mut s = PixelSampler::new(SamplerKind::Sobol, 16, 3, x, 7, i);
+                    for _ in 0..dim {
+                        s.get_1d();
+                    }
+                    s.get_1d()
+                })
+                .collect();
+            v.sort_by(f32::total_cmp);
+            v
+        };
+        let (a, b, c) = (one_d(1, 0), one_d(2, 0), one_d(1, 1));
+        for v in [&a, &b, &c] {
+            assert!(v.iter().enumerate().all(|(i, &x)| (x * 16.0) as usize == i), "{v:?}");
+        }
+        assert!(a != b && a != c, "{a:?} {b:?} {c:?}");
+    }
+
+    #[test]
+    fn dimension_hashes_are_one_to_one() {
+        // For a fixed dimension d the hash is a bijection of the pixel's hash (xor with d·φ,
+        // φ = 0x9e37_79b9_7f4a_7c15 odd, then mix64), so two pixels never share a dimension's
+        // shuffle and scramble: pixel hashes 0 and φ differ at dimension 1 too (0 ^ φ and
+        // φ ^ φ = 0; an `|` would take both to φ).
+        let sampler = |pixel_hash| PixelSampler { kind: SamplerKind::Sobol, spp: 16, index: 0, dim: 0, pixel_hash, rng: Pcg32::new(0, 0) };
+        let (mut a, mut b) = (sampler(0), sampler(0x9e37_79b9_7f4a_7c15));
+        for d in 0..64 {
+            assert_ne!(a.dimension_hash(), b.dimension_hash(), "dimension {d}");
+        }
+        // For a fixed pixel, d ↦ d·φ is one-to-one mod 2⁶⁴: 1000 dimensions, 1000 hashes.
+        let mut s = sampler(0x1234_5678_9abc_def0);
+        let mut seen = std::collections::HashSet::new();
+        for d in 0..1000 {
+            assert!(seen.insert(s.dimension_hash()), "dimension {d}");
+        }
+    }
+
+    #[test]
+    fn the_pixel_position_is_the_first_stratified_pair() {
+        // Jittered with 4 samples: one film position in each quadrant of the pixel, and the
+        // same values as the first get_2d of an identical sampler.
+        let mut quadrants = [0; 4];
+        for i in 0..4 {
+            let p = PixelSampler::new(SamplerKind::Jittered, 4, 1, 2, 3, i).pixel_2d();
+            assert_eq!(p, PixelSampler::new(SamplerKind::Jittered, 4, 1, 2, 3, i).get_2d());
+            quadrants[(p.x >= 0.5) as usize + 2 * (p.y >= 0.5) as usize] += 1;
+        }
+        assert_eq!(quadrants, [1; 4]);
+    }
+
+    /// Kensler 2013 ("Correlated Multi-Jittered Sampling", Pixar Technical Memo 13-01), the
+    /// listing of `permute(i, l, p)` transcribed as printed (C `unsigned` arithmetic, a
+    /// do-while cycle walk): the reference for `permutation_element`.
+    fn kensler_permute(mut i: u32, l: u32, p: u32) -> u32 {
+        let mut w = l - 1;
+        w |= w >> 1;
+        w |= w >> 2;
+        w |= w >> 4;
+        w |= w >> 8;
+        w |= w >> 16;
+        loop {
+            i ^= p;
+            i = i.wrapping_mul(0xe170893d);
+            i ^= p >> 16;
+            i ^= (i & w) >> 4;
+            i ^= p >> 8;
+            i = i.wrapping_mul(0x0929eb3f);
+            i ^= p >> 23;
+            i ^= (i & w) >> 1;
+            i = i.wrapping_mul(1 | p >> 27);
+            i = i.wrapping_mul(0x6935fa69);
+            i ^= (i & w) >> 11;
+            i = i.wrapping_mul(0x74dcb303);
+            i ^= (i & w) >> 2;
+            i = i.wrapping_mul(0x9e501cc3);
+            i ^= (i & w) >> 2;
+            i = i.wrapping_mul(0xc860a3df);
+            i &= w;
+            i ^= i >> 5;
+            if i < l {
+                // The sum in 64 bits: C's 32-bit sum wraps for p > 2³² − 1 − i (see below).
+                return ((i as u64 + p as u64) % l as u64) as u32;
+            }
+        }
+    }
+
+    #[test]
+    fn permutations_are_kenslers() {
+        // Any permutation keeps the strata, so only the published function can tell a changed
+        // shift or mask apart; the images' reproducibility depends on it. Powers of two (the
+        // mask exactly n − 1, no cycle walk) and not, and seeds with every shifted part set.
+        // Indices past n wrap (i mod n) before the walk. The step `(i & w) >> 11` is 0 below
+        // n = 2¹¹ + 1, hence 4096 and 5000.
+        for n in [2u32, 3, 5, 16, 17, 64, 100, 1000, 4096, 5000] {
+            for p in [0u32, 1, 0x8000_0001, 0xdead_beef, 0x1234_5678, 0xffff_ffff] {
+                for i in 0..n {
+                    assert_eq!(permutation_element(i, n, p), kensler_permute(i, n, p), "i {i}, n {n}, p {p:#x}");
+                    assert_eq!(permutation_element(i + n, n, p), kensler_permute(i, n, p), "i {} wraps, n {n}, p {p:#x}", i + n);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn seeds_near_the_top_still_give_permutations() {
+        // A bug, fixed: `(i + p) % n` in u32 overflowed for p > 2³² − 1 − i (a hash of a pixel
+        // and dimension, so about i/2³² of the calls): a panic in debug builds, and in release
+        // not a permutation: n = 3, p = 2³² − 1 wrapped 1 + p to 0 and 2 + p to 1, while 0 + p
+        // ≡ 0 (mod 3, as 2³² ≡ 1), so two samples shared stratum 0.
+        for (n, p) in [(3u32, u32::MAX), (16, u32::MAX), (16, u32::MAX - 15), (1000, u32::MAX), (1000, u32::MAX - 999)] {
+            let mut seen = vec![false; n as usize];
+            for i in 0..n {
+                let e = permutation_element(i, n, p);
+                assert!(!std::mem::replace(&mut seen[e as usize], true), "n {n} p {p:#x}: {e} twice");
+            }
+        }
+    }
+
+    /// pbrt-v4's `FastOwenScrambler` (after Burley 2020, "Practical Hash-based Owen
+    /// Scrambling"), transcribed: the reference for `owen_scramble`.
+    fn pbrt_fast_owen(v: u32, seed: u32) -> u32 {
+        let mut v = v.reverse_bits();
+        v ^= v.wrapping_mul(0x3d20adea);
+        v = v.wrapping_add(seed);
+        v = v.wrapping_mul((seed >> 16) | 1);
+        v ^= v.wrapping_mul(0x05526c56);
+        v ^= v.wrapping_mul(0x53a22864);
+        v.reverse_bits()
+    }
+
+    #[test]
+    fn owen_scrambling_is_pbrts() {
+        // The nesting test above holds for any multiplier (seed >> 16) | 1 that is odd; the
+        // published hash pins which.
+        let mut rng = Pcg32::new(11, 3);
+        for _ in 0..200 {
+            let (v, seed) = (rng.next_u32(), rng.next_u32());
+            assert_eq!(owen_scramble(v, seed), pbrt_fast_owen(v, seed), "v {v:#x}, seed {seed:#x}");
         }
     }
 }

@@ -428,6 +428,18 @@ mod tests {
     }
 
     #[test]
+    fn a_scene_without_emitters_has_no_area_lights() {
+        // Only the dark triangle: nothing to choose, no sample, no density.
+        let mut g = Geometry::default();
+        g.add_mesh(TriangleMesh { name: "dark".into(), positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y], indices: vec![[0, 1, 2]], ..Default::default() });
+        let lights = AreaLights::new(&g, 4);
+        assert!(lights.is_empty());
+        assert_eq!(lights.len(), 0);
+        assert!(lights.sample(&g, &[], Vec3::new(0.2, 0.2, 1.0), &|_| 1.0, LightSampling::Uniform, 0.5, Vec2::splat(0.5)).is_none());
+        assert_eq!(lights.pdf(&g, LightSampling::Uniform, 0, Vec3::new(0.2, 0.2, 1.0), Vec3::new(0.2, 0.2, 0.0), Vec3::Z), 0.0);
+    }
+
+    #[test]
     fn samples_pick_emitters_by_the_cdf_and_report_their_density() {
         let g = scene();
         let lights = AreaLights::new(&g, 4);
@@ -614,6 +626,44 @@ mod tests {
     }
 
     #[test]
+    fn a_cell_owns_the_start_of_its_cdf_interval() {
+        // Cells invert their CDF half-open, as the emitter choice does (the first CDF value
+        // above u): with a receiver taking nothing, k = 2 cells of ¼ each (sums 0.25, 0.5, 0.75,
+        // exact in f32), u_cell = 2·u_choice exactly 0.25 or 0.5 is the start of cell (1, 0),
+        // centre (0.5, 1, −0.5), or of cell (0, 1), centre (−0.5, 1, 0.5).
+        let mut g = Geometry::default();
+        g.add_mesh(quad(A, 3.0));
+        let lights = AreaLights::new(&g, 2);
+        for (u_choice, centre) in [(0.125f32, Vec3::new(0.5, 1.0, -0.5)), (0.25, Vec3::new(-0.5, 1.0, 0.5))] {
+            let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 0.0, LightSampling::Cells, u_choice, Vec2::splat(0.5)).unwrap();
+            assert!((s.wi * s.dist - centre).length() < 1e-5, "{u_choice}: {} against {centre}", s.wi * s.dist);
+        }
+    }
+
+    #[test]
+    fn cells_are_weighed_by_the_emission_texture() {
+        // A (radiance 1) with the grey 2 × 2 texture [1, 2 | 3, 4] (row 0 at v > ½), k = 2
+        // cells on its texels, from the origin with a receiver taking everything: the four
+        // centres (±½, 1, ±½) have the same d² and cosine, so the weights are the texels'
+        // luminances, cells (0, 0), (1, 0), (0, 1), (1, 1) reading 3, 4, 1, 2 (sum 10), and
+        // the probabilities 0.9·lum/10 + 0.1/4: 0.295, 0.385, 0.115, 0.205 (CDF 0.295, 0.68,
+        // 0.795, 1). Each centre comes with density prob·(4 cells/area 4)·d²/cos = prob·1.5^1.5
+        // and its texel's radiance.
+        let mut g = Geometry::default();
+        g.add_mesh(TriangleMesh { uvs: vec![Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y], emission_texture: Some(crate::material::TextureId(0)), ..quad(A, 1.0) });
+        let texels = vec![Rgb::splat(1.0), Rgb::splat(2.0), Rgb::splat(3.0), Rgb::splat(4.0)];
+        let textures = [Texture::Image(crate::texture::ImageTexture::new(2, 2, texels, crate::texture::Wrap::Clamp, crate::texture::Filter::Nearest).unwrap())];
+        let lights = AreaLights::new(&g, 2);
+        // u_cell = 2·u_choice in A's first triangle: the middle of each cell's interval.
+        for (u_cell, centre, lum, prob) in [(0.1475f32, Vec3::new(-0.5, 1.0, -0.5), 3.0, 0.295), (0.4875, Vec3::new(0.5, 1.0, -0.5), 4.0, 0.385), (0.7375, Vec3::new(-0.5, 1.0, 0.5), 1.0, 0.115), (0.8975, Vec3::new(0.5, 1.0, 0.5), 2.0, 0.205)] {
+            let s = lights.sample(&g, &textures, Vec3::ZERO, &|_| 1.0, LightSampling::Cells, u_cell / 2.0, Vec2::splat(0.5)).unwrap();
+            assert!((s.wi * s.dist - centre).length() < 1e-5, "{u_cell}: {} against {centre}", s.wi * s.dist);
+            assert!(close(s.pdf, prob * 1.5f64.powf(1.5), 1e-5), "{u_cell}: {} against {}", s.pdf, prob * 1.5f64.powf(1.5));
+            assert!((s.le.x - lum).abs() < 1e-6 && (s.le.y - lum).abs() < 1e-6, "{u_cell}: {:?}", s.le);
+        }
+    }
+
+    #[test]
     fn a_mesh_is_a_parallelogram_only_with_both_triangles() {
         // A's four corners but only the triangle (a, b, c) (d unused), and B after it: no
         // parallelogram, so the triangle's solid-angle density is its area one, the whole
@@ -643,6 +693,32 @@ mod tests {
             let lights = AreaLights::new(&g, 2);
             let p = lights.pdf(&g, LightSampling::SolidAngle, 0, Vec3::ZERO, Vec3::new(0.0, 1.0, 0.0), -Vec3::Y);
             assert!(close(p, 1.0 / omega, 1e-4), "c {c}, d {d}: {p} against {}", 1.0 / omega);
+        }
+        // (iii) The same light turned a quarter, e2 = d − a now the longer edge (4), c off by
+        // 3·10⁻⁵: the scale is the longer of the two edges, whichever it is.
+        let mut g = Geometry::default();
+        g.add_mesh(quad([Vec3::new(-1.0, 1.0, -2.0), Vec3::new(1.0, 1.0, -2.0), Vec3::new(1.0 + 3e-5, 1.0, 2.0), Vec3::new(-1.0, 1.0, 2.0)], 1.0));
+        let p = AreaLights::new(&g, 2).pdf(&g, LightSampling::SolidAngle, 0, Vec3::ZERO, Vec3::new(0.0, 1.0, 0.0), -Vec3::Y);
+        assert!(close(p, 1.0 / omega, 1e-4), "e2 the longer edge: {p} against {}", 1.0 / omega);
+    }
+
+    #[test]
+    fn quads_past_the_tolerances_are_two_triangles() {
+        // The 4 × 2 light of the test above moved 20 along x (so that a sum of corners, as
+        // |d + a| ≈ 36, would give a much looser tolerance than the longer edge, 4), seen from
+        // p = (20, 0, 0) below its centre: (i) c off by 10⁻⁴ along x, 2.5 × the tolerance
+        // 10⁻⁵·4, is no parallelogram; (ii) c and d both shifted by 10⁻⁴ along x is a
+        // parallelogram with e1·e2 = 4·10⁻⁴, 5 × the right-angle tolerance 10⁻⁵·4·2, so no
+        // rectangle. Either way its solid-angle density is the area one of triangle 0 (area
+        // 4 to within 10⁻⁴, half the choice): ½/4·d²/cos = ⅛ at the foot, not 1/Ω = 0.365.
+        let t = Vec3::new(20.0, 0.0, 0.0);
+        let (a, b) = (t + Vec3::new(-2.0, 1.0, -1.0), t + Vec3::new(2.0, 1.0, -1.0));
+        for (c, d) in [(t + Vec3::new(2.0 + 1e-4, 1.0, 1.0), t + Vec3::new(-2.0, 1.0, 1.0)), (t + Vec3::new(2.0 + 1e-4, 1.0, 1.0), t + Vec3::new(-2.0 + 1e-4, 1.0, 1.0))] {
+            let mut g = Geometry::default();
+            g.add_mesh(quad([a, b, c, d], 1.0));
+            let lights = AreaLights::new(&g, 2);
+            let p = lights.pdf(&g, LightSampling::SolidAngle, 0, t, t + Vec3::Y, -Vec3::Y);
+            assert!(close(p, 0.125, 1e-4), "c {c}, d {d}: {p}");
         }
     }
 
@@ -709,6 +785,56 @@ mod tests {
         assert!(close(p, 2.25 / std::f64::consts::PI, 1e-5), "{p}");
         // From inside, the emitter's outside faces away: no sample.
         assert!(lights.sample(&g, &[], c + Vec3::new(0.1, 0.2, 0.0), &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(0.4, 0.7)).is_none());
+    }
+
+    #[test]
+    fn cone_samples_from_off_the_origin_land_on_the_sphere() {
+        // The radius-1 sphere at distance 2 of the test above, the whole scene moved by t: each
+        // sample's direction makes the same angle with the axis, cos θ = 1 − u.x(1 − √3/2), and
+        // its point p + wi·dist (distance 2cos θ − √(1 − 4 sin²θ)) lies on the sphere.
+        let t = Vec3::new(0.7, -0.4, 0.3);
+        let c = t + Vec3::new(0.0, 0.0, 2.0);
+        let mut g = Geometry::default();
+        g.add_sphere(Sphere { center: c, radius: 1.0, to_world: Transform::IDENTITY, material: Default::default(), emission: Rgb::ONE });
+        let lights = AreaLights::new(&g, 2);
+        let cos_max = 3f64.sqrt() / 2.0;
+        for (ux, uy) in [(0.1f32, 0.2f32), (0.5, 0.7), (0.8, 0.45)] {
+            let s = lights.sample(&g, &[], t, &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(ux, uy)).unwrap();
+            let cos = 1.0 - ux as f64 * (1.0 - cos_max);
+            assert!(close(s.wi.z, cos, 1e-5), "{ux}: wi {}", s.wi);
+            assert!(close(s.dist, 2.0 * cos - (1.0 - 4.0 * (1.0 - cos * cos)).max(0.0).sqrt(), 1e-4), "{ux}: dist {}", s.dist);
+            assert!(((t + s.wi * s.dist - c).length() - 1.0).abs() < 1e-5, "{ux}: {} off the sphere", t + s.wi * s.dist);
+        }
+    }
+
+    #[test]
+    fn from_the_spheres_surface_densities_are_the_area_ones() {
+        // p = (0, 0, 1) on the radius-1 sphere at (0, 0, 2): d² = r² exactly, where `sample`
+        // falls back to area sampling, so `pdf` must too: towards the far point (0, 0, 3),
+        // 1/(4π)·d²/cos = 4/(4π) = 1/π, not the cone's 1/(2π(1 − cos θmax)) = 1/(2π) (θmax = 90°).
+        let mut g = Geometry::default();
+        g.add_sphere(Sphere { center: Vec3::new(0.0, 0.0, 2.0), radius: 1.0, to_world: Transform::IDENTITY, material: Default::default(), emission: Rgb::ONE });
+        let lights = AreaLights::new(&g, 2);
+        for strategy in [LightSampling::SolidAngle, LightSampling::Mis, LightSampling::Uniform] {
+            let p = lights.pdf(&g, strategy, 0, Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 0.0, 3.0), Vec3::Z);
+            assert!(close(p, 1.0 / std::f64::consts::PI, 1e-6), "{strategy:?}: {p}");
+        }
+    }
+
+    #[test]
+    fn tiny_caps_hit_the_sampled_angle_precisely() {
+        // Radius 0.01 at distance 1 (sin²θmax = 10⁻⁴): the direction's sin²θ must be 10⁻⁴·u.x
+        // to f32 precision (10⁻⁵ relative here), not just to the 2·10⁻³ of the test below: a
+        // cos θ of √(1 + sin²θ) in place of √(1 − sin²θ) moves the point by ~5·10⁻⁷, 10⁻⁴ of
+        // sin²θ.
+        let mut g = Geometry::default();
+        g.add_sphere(Sphere { center: Vec3::new(0.0, 1.0, 0.0), radius: 0.01, to_world: Transform::IDENTITY, material: Default::default(), emission: Rgb::ONE });
+        let lights = AreaLights::new(&g, 2);
+        for ux in [0.25f32, 0.5, 0.9] {
+            let s = lights.sample(&g, &[], Vec3::ZERO, &|_| 1.0, LightSampling::SolidAngle, 0.5, Vec2::new(ux, 0.2)).unwrap();
+            let sin2 = s.wi.cross(Vec3::Y).length_squared();
+            assert!(close(sin2, 1e-4 * ux as f64, 1e-5), "{ux}: sin² {sin2} against {}", 1e-4 * ux as f64);
+        }
     }
 
     #[test]
