@@ -5,7 +5,7 @@
 //!
 //! - `node.rs`: the memory layout and its byte budget, and the [`Layout`] of a node's boxes;
 //! - `quant.rs`: the quantised 8-wide node (`bvh8q`, 96 bytes instead of 224);
-//! - `collapse.rs`: binary → wide, Embree's largest-area-first opening;
+//! - `collapse.rs`: binary → wide, by a cost-driven programme (Ylitie et al. 2017);
 //! - `kernels.rs`: box and triangle kernels, SIMD and portable with identical answers;
 //! - `traverse.rs`: closest and any hit, counting or not;
 //! - `packet.rs`: closest hits of 16-ray packets (4×4 tiles of camera rays).
