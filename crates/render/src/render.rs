@@ -234,14 +234,8 @@ fn camera_ray(scene: &Scene, x: u32, y: u32, i: u32) -> (Ray, PixelSampler) {
     let inv = Vec2::new(1.0 / s.width as f32, 1.0 / s.height as f32);
     let mut sampler = PixelSampler::new(s.sampler, s.spp, s.seed, x, y, i);
     let film = (Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + s.filter.offset(sampler.pixel_2d())) * inv;
-    // A pinhole camera ignores the lens sample: skip its computation, not its dimension.
-    let lens = if scene.camera.aperture > 0.0 {
-        sampler.get_2d()
-    } else {
-        sampler.skip_2d();
-        Vec2::ZERO
-    };
-    (scene.camera.ray(film, lens), sampler)
+    let ray = scene.camera.ray(film, sampler.get_2d());
+    (ray, sampler)
 }
 
 /// Adds a sample's radiance to a pixel's sums (RGB and squared luminance), or counts it in

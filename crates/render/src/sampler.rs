@@ -51,16 +51,13 @@ pub struct PixelSampler {
     dim: u32,
     pixel_hash: u64,
     rng: Pcg32,
-    /// The jittered sampler's strata per side, `round(√spp)` (2D samples use `side²` strata).
-    side: u32,
 }
 
 impl PixelSampler {
     pub fn new(kind: SamplerKind, spp: u32, seed: u64, x: u32, y: u32, index: u32) -> Self {
         let pixel_hash = mix64(seed ^ mix64(((x as u64) << 32) | y as u64));
         let rng = Pcg32::new(pixel_hash, index as u64);
-        let side = (spp.max(1) as f32).sqrt().round().max(1.0) as u32;
-        Self { kind, spp: spp.max(1), index, dim: 0, pixel_hash, rng, side }
+        Self { kind, spp: spp.max(1), index, dim: 0, pixel_hash, rng }
     }
 
     /// A hash of this pixel and the next dimension, for shuffles and scrambles.
@@ -91,7 +88,7 @@ impl PixelSampler {
             SamplerKind::Random => self.rng.next_vec2(),
             SamplerKind::Jittered => {
                 let h = self.dimension_hash();
-                let n = self.side;
+                let n = (self.spp as f32).sqrt().round().max(1.0) as u32;
                 let stratum = permutation_element(self.index, n * n, h as u32);
                 sampling::jittered(stratum, n, self.rng.next_vec2())
             }
@@ -102,22 +99,6 @@ impl PixelSampler {
                 let h2 = mix64(h);
                 Vec2::new(to_unit(owen_scramble(a, (h >> 32) as u32)), to_unit(owen_scramble(b, (h2 >> 32) as u32)))
             }
-        }
-    }
-
-    /// Moves past the next 2D sample without computing it, leaving the sampler exactly as
-    /// [`PixelSampler::get_2d`] would (the same dimension, the same random stream): for a
-    /// pinhole camera's unused lens sample.
-    pub fn skip_2d(&mut self) {
-        match self.kind {
-            SamplerKind::Random => {
-                self.rng.next_vec2();
-            }
-            SamplerKind::Jittered => {
-                self.dim += 1;
-                self.rng.next_vec2();
-            }
-            SamplerKind::Sobol => self.dim += 1,
         }
     }
 
@@ -448,7 +429,7 @@ mod tests {
         // φ = 0x9e37_79b9_7f4a_7c15 odd, then mix64), so two pixels never share a dimension's
         // shuffle and scramble: pixel hashes 0 and φ differ at dimension 1 too (0 ^ φ and
         // φ ^ φ = 0; an `|` would take both to φ).
-        let sampler = |pixel_hash| PixelSampler { kind: SamplerKind::Sobol, spp: 16, index: 0, dim: 0, pixel_hash, rng: Pcg32::new(0, 0), side: 4 };
+        let sampler = |pixel_hash| PixelSampler { kind: SamplerKind::Sobol, spp: 16, index: 0, dim: 0, pixel_hash, rng: Pcg32::new(0, 0) };
         let (mut a, mut b) = (sampler(0), sampler(0x9e37_79b9_7f4a_7c15));
         for d in 0..64 {
             assert_ne!(a.dimension_hash(), b.dimension_hash(), "dimension {d}");
@@ -562,22 +543,6 @@ mod tests {
         for _ in 0..200 {
             let (v, seed) = (rng.next_u32(), rng.next_u32());
             assert_eq!(owen_scramble(v, seed), pbrt_fast_owen(v, seed), "v {v:#x}, seed {seed:#x}");
-        }
-    }
-
-    /// Skipping a 2D sample leaves the sampler where computing it would: every later sample
-    /// of every kind is the same, bit for bit.
-    #[test]
-    fn skipping_a_2d_sample_keeps_the_later_ones() {
-        for kind in [SamplerKind::Random, SamplerKind::Jittered, SamplerKind::Sobol] {
-            for i in 0..16 {
-                let (mut a, mut b) = (PixelSampler::new(kind, 16, 9, 4, 5, i), PixelSampler::new(kind, 16, 9, 4, 5, i));
-                assert_eq!(a.pixel_2d(), b.pixel_2d());
-                a.get_2d();
-                b.skip_2d();
-                let later = |s: &mut PixelSampler| [s.get_1d(), s.get_2d().x, s.get_2d().y, s.get_1d()];
-                assert_eq!(later(&mut a).map(f32::to_bits), later(&mut b).map(f32::to_bits), "{kind} sample {i}");
-            }
         }
     }
 }
