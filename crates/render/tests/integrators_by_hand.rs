@@ -207,6 +207,11 @@ fn an_emitter_seen_directly_shows_its_radiance_from_the_front_only() {
             assert_every_sample(&scene, &from_below, 8, le, &format!("{integrator} {strategy} front"));
             let from_above = ray_between(Vec3::new(0.3, 2.0, 0.2), Vec3::new(0.5, 1.0, 0.1));
             assert_every_sample(&scene, &from_above, 8, Rgb::ZERO, &format!("{integrator} {strategy} back"));
+            // A black surface ends the path: under BSDF sampling (no shadow rays) the camera
+            // ray is the only ray traced.
+            if strategy == LightSampling::Bsdf && integrator != IntegratorKind::Whitted {
+                assert_eq!(trace_counted(&scene, &from_below, 0).1.rays, 1, "{integrator}");
+            }
         }
     }
 }
@@ -376,8 +381,12 @@ fn fresnel(n1: f64, n2: f64, cos_i: f64) -> f64 {
 /// The plane y = 0 bounds glass (n = 1.5) below it (its winding normal up: outside is +y);
 /// a black emitter of radiance `le` lies at y = −1 facing up; the background above is c.
 fn glass_scene(integrator: IntegratorKind, max_depth: u32, le: f32, flipped_normals: bool) -> Scene {
+    glass_scene_of(integrator, max_depth, le, flipped_normals, 1.5)
+}
+
+fn glass_scene_of(integrator: IntegratorKind, max_depth: u32, le: f32, flipped_normals: bool, ior: f32) -> Scene {
     let mut scene = empty_scene(integrator, LightSampling::Mis, max_depth);
-    let glass = scene.add_material("glass", Material::Dielectric { ior: 1.5 });
+    let glass = scene.add_material("glass", Material::Dielectric { ior });
     let black = diffuse(&mut scene, Rgb::ZERO);
     let mut surface = floor(glass, 0.0, 50.0, true);
     if flipped_normals {
@@ -456,6 +465,29 @@ fn whitted_stops_refraction_at_the_depth_limit() {
     let fc = f as f32 * BACKGROUND;
     assert_every_sample(&scene_with(2), &ray, 1, fc, "max_depth 2");
     assert_every_sample(&scene_with(3), &ray, 1, fc + Rgb::splat(((1.0 - f) * floor_l) as f32), "max_depth 3");
+    // From inside the glass at 30° the reflected ray is the one that reaches the floor: from
+    // x = −1.5 tan 30° at y = −0.5 it meets the glass at x = −tan 30° and the floor right
+    // under the light, d = 0.5, cos θ = 1, E = 1/0.25 = 4, L = ρ/π·4. The transmitted ray
+    // sees the background: (1 − F)·c with F = fresnel(1.5, 1, cos 30°).
+    let t30 = 30f32.to_radians().tan();
+    let ray = Ray::new(Vec3::new(-1.5 * t30, -0.5, 0.0), Vec3::new(30f32.to_radians().sin(), 30f32.to_radians().cos(), 0.0));
+    let f = fresnel(1.5, 1.0, 30f64.to_radians().cos()) as f32;
+    let tc = (1.0 - f) * BACKGROUND;
+    assert_every_sample(&scene_with(2), &ray, 1, tc, "from inside, max_depth 2");
+    assert_every_sample(&scene_with(3), &ray, 1, tc + Rgb::splat(f * 0.5 / PI * 4.0), "from inside, max_depth 3");
+}
+
+#[test]
+fn glass_of_index_below_one_transmits_away_from_the_normal() {
+    // ior = 2/3: the outside is the denser side (a bubble). From outside at 30°,
+    // sin θt = 1.5 sin 30° = 0.75: the refracted ray leaves at a grazier angle than it came,
+    // and must still be followed as transmission. F = fresnel(1.5, 1, cos 30°); the path
+    // tracer scales transmitted radiance by 1/η² = 1.5².
+    let ray = Ray::new(Vec3::new(0.0, 0.5, 0.0), Vec3::new(30f32.to_radians().sin(), -30f32.to_radians().cos(), 0.0));
+    let f = fresnel(1.5, 1.0, 30f64.to_radians().cos()) as f32;
+    let whitted = f * BACKGROUND + (1.0 - f) * Rgb::splat(3.0);
+    assert_every_sample(&glass_scene_of(IntegratorKind::Whitted, 8, 3.0, false, 1.0 / 1.5), &ray, 1, whitted, "whitted");
+    assert_mean(&glass_scene_of(IntegratorKind::Path, 8, 3.0, false, 1.0 / 1.5), &ray, 8192, f * BACKGROUND.y + (1.0 - f) * 3.0 * 2.25, "path");
 }
 
 #[test]
