@@ -121,6 +121,9 @@ mod tests {
         let f = fibre_frame(n, Vec3::new(2.0, 0.3, 0.0));
         assert!(f.z == n && f.x.dot(n).abs() < 1e-6 && (f.x.length() - 1.0).abs() < 1e-6 && f.x.x > 0.9);
         assert!((f.x.cross(f.y) - f.z).length() < 1e-5, "right-handed");
+        // x is the tangent's part across n, t − n(n·t) = (2, 0.3 − 0.6·0.18, −0.8·0.18), normalised.
+        let want = Vec3::new(2.0, 0.192, -0.144) / (4.0f32 + 0.192 * 0.192 + 0.144 * 0.144).sqrt();
+        assert!((f.x - want).length() < 1e-6, "{} vs {want}", f.x);
         let fallback = fibre_frame(n, n);
         assert!(fallback.x.dot(n).abs() < 1e-6);
     }
