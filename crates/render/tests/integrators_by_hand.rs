@@ -531,26 +531,29 @@ fn emission_adds_to_reflected_light() {
 
 #[test]
 fn hair_is_shaded_with_the_fibre_along_dpdu() {
-    // A Kajiya–Kay floor whose uvs run along x, so the fibre tangent is T = +x. Light from a
-    // point light of intensity 4 at (0.6, 0.8, 0)·2 from p = 0 (E = 1), seen from
-    // wo = (−0.36, 0.8, 0.48): sin(T, wi) = 0.8, sin(T, wo) = √(1 − 0.36²), T·wi = 0.6,
-    // T·wo = −0.36. f = (colour·kd·sin_i + ks·cos^p θ')/π with
-    // cos θ' = sin_i sin_o − (T·wi)(T·wo); L = f·E·cos θi, cos θi = 0.8.
+    // A Kajiya–Kay floor whose uvs make ∂p/∂u, the fibre tangent T, run along +x, or along
+    // the diagonal (1, 0, 1)/√2 (u = x + z, v = z − x). Light from a point light of intensity
+    // 4 at (0.6, 0.8, 0)·2 from p = 0 (E = 1, cos θi = 0.8), seen from wo = (−0.36, 0.8, 0.48).
+    // f = (colour·kd·sin(T, wi) + ks·cos^p θ')/π with cos θ' = sin_i sin_o − (T·wi)(T·wo),
+    // sin(T, w) = √(1 − (T·w)²); L = f·E·cos θi.
     let (color, kd, ks, p) = (Rgb::new(0.9, 0.6, 0.3), 0.7f32, 0.4f32, 5.0f32);
-    let wo = Vec3::new(-0.36, 0.8, 0.48);
-    let (sin_i, sin_o) = (0.8f32, (1.0f32 - 0.36 * 0.36).sqrt());
-    let cos_cone = sin_i * sin_o - 0.6 * -0.36;
-    let f = (color * (kd * sin_i) + Rgb::splat(ks * cos_cone.powf(p))) / PI;
-    let want = f * 0.8;
-    for integrator in [IntegratorKind::Whitted, IntegratorKind::Direct, IntegratorKind::Path] {
-        let mut scene = empty_scene(integrator, LightSampling::Mis, 8);
-        let m = scene.add_material("hair", Material::Hair { color: TexColor::Constant(color), kd, ks, exponent: p });
-        let mut mesh = floor(m, 0.0, 50.0, true);
-        mesh.uvs = mesh.positions.iter().map(|v| Vec2::new(v.x, v.z)).collect();
-        scene.geometry.add_mesh(mesh);
-        scene.lights.push(Light::Point { position: 2.0 * Vec3::new(0.6, 0.8, 0.0), intensity: Rgb::splat(4.0) });
-        scene.build_accel(&BuildOptions::default());
-        assert_every_sample(&scene, &ray_between(wo, Vec3::ZERO), 8, want, &format!("{integrator}"));
+    let (wi, wo) = (Vec3::new(0.6, 0.8, 0.0), Vec3::new(-0.36, 0.8, 0.48));
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    // (T·wi, T·wo) worked out: (0.6, −0.36) along x; (0.6/√2, (−0.36 + 0.48)/√2) on the diagonal.
+    for (uv, (ti, to)) in [(&(|v: Vec3| Vec2::new(v.x, v.z)) as &dyn Fn(Vec3) -> Vec2, (0.6f32, -0.36f32)), (&|v: Vec3| Vec2::new(v.x + v.z, v.z - v.x), (0.6 * s, 0.12 * s))] {
+        let (sin_i, sin_o) = ((1.0 - ti * ti).sqrt(), (1.0 - to * to).sqrt());
+        let cos_cone = sin_i * sin_o - ti * to;
+        let want = (color * (kd * sin_i) + Rgb::splat(ks * cos_cone.powf(p))) / PI * 0.8;
+        for integrator in [IntegratorKind::Whitted, IntegratorKind::Direct, IntegratorKind::Path] {
+            let mut scene = empty_scene(integrator, LightSampling::Mis, 8);
+            let m = scene.add_material("hair", Material::Hair { color: TexColor::Constant(color), kd, ks, exponent: p });
+            let mut mesh = floor(m, 0.0, 50.0, true);
+            mesh.uvs = mesh.positions.iter().map(|&v| uv(v)).collect();
+            scene.geometry.add_mesh(mesh);
+            scene.lights.push(Light::Point { position: 2.0 * wi, intensity: Rgb::splat(4.0) });
+            scene.build_accel(&BuildOptions::default());
+            assert_every_sample(&scene, &ray_between(wo, Vec3::ZERO), 8, want, &format!("{integrator}, T·wi = {ti}"));
+        }
     }
 }
 
