@@ -217,13 +217,13 @@ fn an_emitter_seen_directly_shows_its_radiance_from_the_front_only() {
 }
 
 /// A Lambertian floor (ρ = 0.5) under a large sphere light, radius r = 0.8 centred at height
-/// d = 1 above p = 0 (its lowest point at 0.1), Le = 1: the irradiance from a sphere wholly
-/// above the horizon is E = π Le (r/d)², so L = ρ Le (r/d)² = 0.32. BSDF samples hit it with
+/// d = 1 above p = 0 (its lowest point at 0.2), Le = 2: the irradiance from a sphere wholly
+/// above the horizon is E = π Le (r/d)², so L = ρ Le (r/d)² = 0.64. BSDF samples hit it with
 /// probability (r/d)² = 0.64, so both strategies carry weight under MIS.
 #[test]
 fn every_strategy_and_heuristic_converges_to_the_large_sphere_light() {
     let ray = ray_between(Vec3::new(2.0, 0.2, 0.0), Vec3::ZERO); // below the sphere all the way
-    let want = 0.5 * 0.64;
+    let want = 0.5 * 2.0 * 0.64;
     let mut configs: Vec<(IntegratorKind, LightSampling, MisHeuristic)> = STRATEGIES.iter().map(|&s| (IntegratorKind::Direct, s, MisHeuristic::Power)).collect();
     configs.push((IntegratorKind::Direct, LightSampling::Mis, MisHeuristic::Balance));
     configs.push((IntegratorKind::Path, LightSampling::Mis, MisHeuristic::Power));
@@ -234,7 +234,7 @@ fn every_strategy_and_heuristic_converges_to_the_large_sphere_light() {
         let m = diffuse(&mut scene, Rgb::splat(0.5));
         let black = diffuse(&mut scene, Rgb::ZERO);
         scene.geometry.add_mesh(floor(m, 0.0, 50.0, true));
-        scene.geometry.add_sphere(Sphere { center: Vec3::new(0.0, 1.0, 0.0), radius: 0.8, to_world: Transform::IDENTITY, material: black, emission: Rgb::ONE });
+        scene.geometry.add_sphere(Sphere { center: Vec3::new(0.0, 1.0, 0.0), radius: 0.8, to_world: Transform::IDENTITY, material: black, emission: Rgb::splat(2.0) });
         scene.build_accel(&BuildOptions::default());
         assert_mean(&scene, &ray, 8192, want, &format!("{integrator} {strategy} {heuristic}"));
     }
@@ -311,23 +311,23 @@ fn a_closed_box_shuts_out_every_light_outside_it() {
 
 #[test]
 fn environment_seen_directly_and_reflected_by_a_lambertian_floor() {
-    // A constant sky of radiance 2 scaled by (1, 0.5, 0.25). A camera ray that escapes sees it
+    // A constant sky of radiance 2 scaled by (1, 0.75, 0.25). A camera ray that escapes sees it
     // in full under every strategy; the floor (ρ = 0.5) reflects ρ·L: exactly under BSDF
-    // sampling (weight ρ, environment weight 1), on average otherwise.
-    let sky = Rgb::new(2.0, 1.0, 0.5);
+    // sampling (weight ρ, environment weight 1), on average otherwise (green: 0.5 · 1.5).
+    let sky = Rgb::new(2.0, 1.5, 0.5);
     for strategy in STRATEGIES {
         for integrator in [IntegratorKind::Direct, IntegratorKind::Path] {
             let mut scene = empty_scene(integrator, strategy, 8);
             let m = diffuse(&mut scene, Rgb::splat(0.5));
             scene.geometry.add_mesh(floor(m, 0.0, 50.0, true));
-            scene.environment = Some(constant_environment(2.0, Rgb::new(1.0, 0.5, 0.25)));
+            scene.environment = Some(constant_environment(2.0, Rgb::new(1.0, 0.75, 0.25)));
             scene.build_accel(&BuildOptions::default());
             assert_every_sample(&scene, &ray_between(Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.3, 2.0, 0.1)), 8, sky, &format!("{integrator} {strategy} sky"));
             let down = ray_between(Vec3::new(0.4, 1.0, 0.2), Vec3::ZERO);
             if strategy == LightSampling::Bsdf {
                 assert_every_sample(&scene, &down, 16, 0.5 * sky, &format!("{integrator} bsdf floor"));
             } else {
-                assert_mean(&scene, &down, 4096, 0.5, &format!("{integrator} {strategy} floor"));
+                assert_mean(&scene, &down, 4096, 0.75, &format!("{integrator} {strategy} floor"));
             }
         }
     }
