@@ -83,11 +83,47 @@ mod tests {
     }
 
     #[test]
+    fn hand_value_off_every_axis() {
+        // wi = (0.36, 0.48, 0.8), wo = (−0.6, 0, 0.8), T = x: sin(T, wi) = √(1 − 0.36²),
+        // sin(T, wo) = 0.8, cos θ' = sin_i·0.8 − 0.36·(−0.6) = sin_i·0.8 + 0.216; exponent 3.
+        let kk = KajiyaKay { color: Rgb::new(0.9, 0.6, 0.3), kd: 0.7, ks: 0.4, exponent: 3.0 };
+        let (wi, wo) = (Vec3::new(0.36, 0.48, 0.8), Vec3::new(-0.6, 0.0, 0.8));
+        let sin_i = (1.0f64 - 0.36 * 0.36).sqrt();
+        let cone = sin_i * 0.8 + 0.216;
+        for (c, got) in [0.9f64, 0.6, 0.3].into_iter().zip(kk.eval(wo, wi).to_array()) {
+            let want = (c * 0.7 * sin_i + 0.4 * cone.powi(3)) / std::f64::consts::PI;
+            assert!((got as f64 - want).abs() < 1e-6 * want, "{got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn one_sided_with_a_cosine_density() {
+        // Reflects only with both directions above the surface (module doc), z = 0 included.
+        let kk = KajiyaKay { color: Rgb::ONE, kd: 0.7, ks: 0.4, exponent: 3.0 };
+        let (up, flat, down) = (Vec3::new(0.36, 0.48, 0.8), Vec3::new(0.6, 0.8, 0.0), Vec3::new(0.36, 0.48, -0.8));
+        for (wo, wi) in [(up, down), (down, up), (up, flat), (flat, up), (down, down)] {
+            assert_eq!(kk.eval(wo, wi), Rgb::ZERO, "f({wo}, {wi})");
+        }
+        assert!(kk.eval(up, up).min_element() > 0.0);
+        // Cosine-weighted hemisphere: pdf = cos θi / π whatever wo above the surface.
+        assert!((kk.pdf(Vec3::new(-0.6, 0.0, 0.8), up) - 0.8 / std::f32::consts::PI).abs() < 1e-7);
+        for wo in [down, flat] {
+            assert_eq!(kk.pdf(wo, up), 0.0, "pdf from {wo}");
+            assert!(kk.sample(wo, Vec2::new(0.3, 0.6)).is_none(), "sample from {wo}");
+        }
+        let wi = kk.sample(up, Vec2::new(0.3, 0.6)).unwrap();
+        assert!(wi.z > 0.0 && (wi.length() - 1.0).abs() < 1e-6, "{wi}");
+    }
+
+    #[test]
     fn fibre_frame_puts_the_tangent_on_x() {
         let n = Vec3::new(0.0, 0.6, 0.8);
         let f = fibre_frame(n, Vec3::new(2.0, 0.3, 0.0));
         assert!(f.z == n && f.x.dot(n).abs() < 1e-6 && (f.x.length() - 1.0).abs() < 1e-6 && f.x.x > 0.9);
         assert!((f.x.cross(f.y) - f.z).length() < 1e-5, "right-handed");
+        // x is the tangent's part across n, t − n(n·t) = (2, 0.3 − 0.6·0.18, −0.8·0.18), normalised.
+        let want = Vec3::new(2.0, 0.192, -0.144) / (4.0f32 + 0.192 * 0.192 + 0.144 * 0.144).sqrt();
+        assert!((f.x - want).length() < 1e-6, "{} vs {want}", f.x);
         let fallback = fibre_frame(n, n);
         assert!(fallback.x.dot(n).abs() < 1e-6);
     }

@@ -738,3 +738,29 @@ fn index_matched_dielectric_is_invisible() {
         }
     }
 }
+
+#[test]
+fn phong_chooses_its_lobes_in_proportion_to_their_luminance() {
+    // `lobe_probability`: the specular lobe is chosen with probability
+    // p = Y(ks) / (Y(kd) + Y(ks)), Y the Rec. 709 luminance 0.2126 R + 0.7152 G + 0.0722 B,
+    // and Phong's density mixes the two lobes by it: at the mirror direction (cos α = 1),
+    // pdf = (1 − p)·cos θi/π + p·(n + 1)/(2π).
+    let y = |c: [f64; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    let wo = dir(0.8, 0.4);
+    let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+    let n = 3.0;
+    for (kd, ks) in [([0.3, 0.2, 0.1], [0.5, 0.4, 0.6]), ([0.0; 3], [0.5, 0.4, 0.6]), ([0.3, 0.2, 0.1], [0.0; 3])] {
+        let p = y(ks) / (y(kd) + y(ks));
+        let want = (1.0 - p) * 0.8 / PI64 + p * (n + 1.0) / (2.0 * PI64);
+        let phong = Bsdf::Phong { kd: Rgb::from_array(kd.map(|v| v as f32)), ks: Rgb::from_array(ks.map(|v| v as f32)), exponent: n as f32 };
+        let got = phong.pdf(wo, wi) as f64;
+        assert!((got - want).abs() < 1e-5 * want, "kd {kd:?} ks {ks:?}: pdf {got}, expected {want} (p = {p})");
+        // The diffuse lobe is taken for u_lobe ≥ p: its cosine sample of u = (0.5, 0.5) is the normal.
+        let s = phong.sample(wo, ((p + 1.0) / 2.0) as f32, Vec2::splat(0.5));
+        assert!(p == 1.0 || s.is_some_and(|s| (s.wi - Vec3::Z).length() < 1e-6), "kd {kd:?}: {s:?}");
+    }
+    // Both lobes black: no density and no sample.
+    let black = Bsdf::Phong { kd: Rgb::ZERO, ks: Rgb::ZERO, exponent: n as f32 };
+    assert_eq!(black.pdf(wo, wi), 0.0);
+    assert!(black.sample(wo, 0.5, Vec2::splat(0.5)).is_none());
+}
