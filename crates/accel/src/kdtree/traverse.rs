@@ -300,6 +300,17 @@ mod tests {
         assert_eq!(s.notes[0].1, "1");
         assert_eq!((s.leaves, s.references), (3, 4));
         assert!((s.sah_cost - (1280.0 + 1152.0 + 2.0 * 1088.0 + 2.0 * 1152.0) / 1280.0).abs() < 1e-12);
+        // The build time is passed on; depth counts along above children too: root (depth
+        // 1) split at c = 2 with its above child node 2 (depth 2) split at c = 3, whose
+        // children (nodes 3 and 4) are at depth 3. Voxels: root c ∈ [0, 4] (1280), node 1
+        // c ∈ [0, 2] (1152), node 2 c ∈ [2, 4] (1152), nodes 3, 4 extent 1 (1088).
+        let mut t = scene_k(1).1;
+        t.build_ms = 1.25;
+        t.nodes = vec![KdNode::interior(1, 2.0, 2), KdNode::leaf(0, 2), KdNode::interior(1, 3.0, 4), KdNode::leaf(2, 0), KdNode::leaf(2, 2)];
+        t.indices = vec![1, 0, 3, 2];
+        let s = t.stats();
+        assert_eq!((s.build_ms, s.interior_nodes, s.leaves, s.max_depth, s.references), (1.25, 2, 3, 3, 4));
+        assert!((s.sah_cost - (1280.0 + 1152.0 + 2.0 * 1152.0 + 0.0 * 1088.0 + 2.0 * 1088.0) / 1280.0).abs() < 1e-12, "{}", s.sah_cost);
         let empty = KdTree { nodes: vec![], indices: vec![], bounds: Aabb::EMPTY, margin: 0.0, primitives: 0, build_ms: 0.0 };
         let s = empty.stats();
         assert_eq!((s.interior_nodes, s.leaves, s.max_depth), (0, 0, 0));
