@@ -246,6 +246,14 @@ mod tests {
             // Starting at t = 2.5 (c = 1.5): node 1's plane (t_p = 2) lies before the
             // interval [2.5, 3.25] by more than the slack: node 3 only, then node 4.
             (ray_along(a, 1.0, at(a, -1.0, 10.0, 12.0), 2.5, inf), (Some((3, 3.5)), 4, 4), (true, 4, 3)),
+            // −a from c = 5 starting at t = 2.25 (c = 2.75, past prim 2): above first; node 4
+            // holds no hit, node 1 (stacked from 2.75) is popped and takes its above child
+            // (node 3) first: prim 0 at c = 1.5, t = 3.5; node 2 (from 3.75) dropped.
+            (ray_along(a, -1.0, at(a, 5.0, -4.0, -2.0), 2.25, inf), (Some((0, 3.5)), 4, 4), (true, 4, 3)),
+            // +a at half speed from c = −1: distances double (t_p = 6 and 4) and so does the
+            // slack (½): prim 1 at t = 3.75; node 3 stacked from 3.5 is tested, node 4 (5.5)
+            // dropped.
+            (Ray::new(at(a, -1.0, -4.0, -2.0), 0.5 * ray_along(a, 1.0, Vec3::ZERO, 0.0, inf).dir), (Some((1, 3.75)), 4, 4), (true, 3, 1)),
             // Leaving the root voxel: nothing visited.
             (ray_along(a, -1.0, at(a, -1.0, -4.0, -2.0), 0.0, inf), (None, 0, 0), (false, 0, 0)),
         ]
