@@ -254,6 +254,15 @@ mod tests {
             // slack (½): prim 1 at t = 3.75; node 3 stacked from 3.5 is tested, node 4 (5.5)
             // dropped.
             (Ray::new(at(a, -1.0, -4.0, -2.0), 0.5 * ray_along(a, 1.0, Vec3::ZERO, 0.0, inf).dir), (Some((1, 3.75)), 4, 4), (true, 3, 1)),
+            // From c = −1, u = 14 along (a, u) = (1, 1): the ray leaves the root voxel through
+            // u = 16 at t = 2 (c = 1), before the root plane (t_p = 3, beyond 2 + ¼): node 1
+            // only, where both children are walked (t_p = 2): prims 1 and 0 are missed
+            // (their planes are reached at u = 15.875 and 16.5, outside their halves).
+            (Ray::new(at(a, -1.0, 14.0, 0.0), at(a, 1.0, 1.0, 0.0)), (None, 4, 4), (false, 4, 4)),
+            // +a from c = −1 starting at t = 1.8 (c = 0.8), just before node 1's plane
+            // (t_p = 2): the plane is not before the interval, so node 2 (prim 1 at 1.875)
+            // is walked, then node 3 (from 1.8).
+            (ray_along(a, 1.0, at(a, -1.0, -4.0, -2.0), 1.8, inf), (Some((1, 1.875)), 4, 4), (true, 3, 1)),
             // Leaving the root voxel: nothing visited.
             (ray_along(a, -1.0, at(a, -1.0, -4.0, -2.0), 0.0, inf), (None, 0, 0), (false, 0, 0)),
         ]
@@ -267,6 +276,28 @@ mod tests {
                 assert_eq!(closest(&tree, &prims, &ray), want, "axis {a} ray {k}");
                 assert_eq!(any(&tree, &prims, &ray), want_any, "axis {a} ray {k}: any");
             }
+        }
+    }
+
+    /// Two planes across different axes crossed within the slack of each other: the root
+    /// splits c = 2 (above: node 4), node 1 splits u = 0 (above: node 3); margin ¼, root
+    /// voxel c ∈ [0, 4], u ∈ [−4, 4]. Node 3 (c < 2, u > 0) lists prim 0, a near half at
+    /// c = 2.125, within the margin of its voxel. The ray from (c, u) = (−1, −3.25) along
+    /// (1, 1) crosses c = 2 at t = 3 and u = 0 at t = 3.25: node 1's interval ends at
+    /// 3 + ¼, so its plane (3.25, within the slack of that end) stacks node 3 from 3.0;
+    /// node 2 (empty), node 3 (prim 0 at t = 3.125), node 4 (stacked from 2.75, empty).
+    #[test]
+    fn kdtree_interval_ends_are_widened_by_the_slack() {
+        for a in 0..3 {
+            let (u, v) = ((a + 1) % 3, (a + 2) % 3);
+            let prims = Tris(vec![[at(a, 2.125, -1.0, -17.0), at(a, 2.125, 31.0, -17.0), at(a, 2.125, -1.0, 15.0)]]);
+            let nodes = vec![KdNode::interior(a, 2.0, 4), KdNode::interior(u, 0.0, 3), KdNode::leaf(0, 0), KdNode::leaf(0, 1), KdNode::leaf(1, 0)];
+            let mut lo = [0.0; 3];
+            let mut hi = [0.0; 3];
+            (lo[a], lo[u], lo[v], hi[a], hi[u], hi[v]) = (0.0, -4.0, -16.0, 4.0, 4.0, 16.0);
+            let tree = KdTree { nodes, indices: vec![0], bounds: Aabb::new(Vec3::from_array(lo), Vec3::from_array(hi)), margin: 0.25, primitives: 1, build_ms: 0.0 };
+            let ray = Ray::new(at(a, -1.0, -3.25, -10.0), at(a, 1.0, 1.0, 0.0));
+            assert_eq!(closest(&tree, &prims, &ray), (Some((0, 3.125)), 5, 1), "axis {a}");
         }
     }
 
