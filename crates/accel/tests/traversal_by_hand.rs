@@ -363,6 +363,9 @@ fn scene_w_rays(a: usize) -> Vec<(Ray, Answer, (bool, u64, u64))> {
         // +a from c = 1.5 (between planes): lane 2 and lane 5 behind; lanes 0 (t = ½),
         // 3 (1½), 1 (2½): lane 0 hits at ½.
         (axis_ray(a, 1.0, 1.5, -4.0, -2.0, inf), (Some((0, 0.5)), 2, 1), (true, 2, 1)),
+        // +a ending exactly on lane 2's plane (t_max = 1): its box is entered at t_max,
+        // within the closed interval: as the first ray (lane 5, then lane 2 at t = 1).
+        (axis_ray(a, 1.0, 0.0, -4.0, -2.0, 1.0), (Some((2, 1.0)), 3, 2), (true, 2, 1)),
     ]
 }
 
@@ -536,6 +539,32 @@ fn wide_ties_across_levels() {
             assert_eq!(out[0].map(|h| (h.prim, h.t)), Some((0, 1.0)), "axis {a} {kernel:?}: packet");
             // Any hit: lane 0 first, hit: root and one leaf.
             assert_eq!(any(&w, &soup, &ray), (true, 2, 1), "axis {a} {kernel:?}: any");
+        }
+    }
+}
+
+/// Boxes tested after a hit are tested against it: the root's lane 0 is a leaf with prim 0
+/// at c = 1, lane 1 an interior node (box c ∈ [1, 1.5]) whose only child is a leaf with
+/// prim 1 at c = 1.5. From c = 0 along +a: lane 0 (entry 1, the lower lane of two equal
+/// keys) hits at t = 1; the node (entry 1 ≤ 1·(1 + 2γ₃)) is visited, but its child, entered
+/// at 1.5, is not: root, leaf, node: 3 visits, 1 test.
+#[test]
+fn wide_boxes_after_a_hit_are_tested_against_it() {
+    for a in 0..3 {
+        let soup = Soup::triangles([near_half(a, 1.0, -16.0, -16.0), near_half(a, 1.5, -16.0, -16.0)]);
+        let ray = axis_ray(a, 1.0, 0.0, -4.0, -2.0, f32::INFINITY);
+        for kernel in kernels(8) {
+            let mut root = WideNode::<8>::EMPTY_NODE;
+            root.set(0, &pb(&soup, 0), leaf_ref(0, 1));
+            root.set(1, &pb(&soup, 1).union(pb(&soup, 0)), 1);
+            let mut inner = WideNode::<8>::EMPTY_NODE;
+            inner.set(0, &pb(&soup, 1), leaf_ref(1, 1));
+            let w = wide_by_hand(&soup, vec![root, inner], vec![block(&soup, &[0]), block(&soup, &[1])], 0, kernel);
+            w.validate(&soup).unwrap();
+            assert_eq!(closest(&w, &soup, &ray), (Some((0, 1.0)), 3, 1), "axis {a} {kernel:?}");
+            let mut out = [None];
+            w.intersect_packet(&soup, &[ray], &mut out);
+            assert_eq!(out[0].map(|h| (h.prim, h.t)), Some((0, 1.0)), "axis {a} {kernel:?}: packet");
         }
     }
 }
