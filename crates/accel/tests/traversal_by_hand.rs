@@ -178,6 +178,19 @@ fn binary_bvh_statistics_by_hand() {
     // Five 32-byte nodes and four 4-byte indices.
     assert_eq!(s.memory_bytes, 5 * 32 + 4 * 4);
     assert!(Accel::validate(&bvh, &soup).is_ok());
+    // The same boxes with the interior node on the right: its leaves are at depth 3 too.
+    let nodes = vec![
+        BvhNode::interior(union(&soup, &[0, 1, 2, 3]), 1),
+        BvhNode::leaf(union(&soup, &[1]), 0, 1),
+        BvhNode::interior(union(&soup, &[0, 2, 3]), 3),
+        BvhNode::leaf(union(&soup, &[3]), 1, 1),
+        BvhNode::leaf(union(&soup, &[0, 2]), 2, 2),
+    ];
+    let right = Bvh::from_parts(nodes, vec![1, 3, 2, 0], 4, "by hand");
+    right.validate(&soup).unwrap();
+    let s = right.stats();
+    assert_eq!((s.interior_nodes, s.leaves, s.references, s.max_depth), (2, 3, 4, 3));
+    assert!((s.sah_cost - want).abs() < 1e-12, "SAH {} vs {want}", s.sah_cost);
     // A tree for three primitives given four: the trait's validation reports it.
     let three = Soup::triangles(soup.prims[..3].iter().map(|p| match p {
         Prim::Triangle(v) => *v,
@@ -539,6 +552,35 @@ fn wide_ties_across_levels() {
             assert_eq!(out[0].map(|h| (h.prim, h.t)), Some((0, 1.0)), "axis {a} {kernel:?}: packet");
             // Any hit: lane 0 first, hit: root and one leaf.
             assert_eq!(any(&w, &soup, &ray), (true, 2, 1), "axis {a} {kernel:?}: any");
+        }
+    }
+}
+
+/// A ray starting on a box's face, leaving it backwards: lane 0's box c ∈ [2, 3] (prim 0 at
+/// c = 2.5), lane 1's c ∈ [1, 2] (prim 1 at c = 1.5); from c = 3 along −a. Lane 0's entry
+/// is `(3 − 3)·(−1) = −0`, which the slab test's `max` with `t_min = +0` turns into +0 (as
+/// the SIMD `max` returns its second operand on equal zeros): lane 0 sorts first (its key is
+/// 0, where −0's sign bit would sort it last), hits at t = ½ and lane 1 (entry 1) is dropped:
+/// 2 visits, 1 test.
+#[test]
+fn wide_ray_starting_on_a_box_face() {
+    for a in 0..3 {
+        let soup = Soup::triangles([near_half(a, 2.5, -16.0, -16.0), near_half(a, 1.5, -16.0, -16.0)]);
+        let slab = |lo: f32, hi: f32| Aabb::new(at(a, lo, -16.0, -16.0).min(at(a, hi, 16.0, 16.0)), at(a, lo, -16.0, -16.0).max(at(a, hi, 16.0, 16.0)));
+        let ray = axis_ray(a, -1.0, 3.0, -4.0, -2.0, f32::INFINITY);
+        for kernel in kernels(8) {
+            let mut root = WideNode::<8>::EMPTY_NODE;
+            root.set(0, &slab(2.0, 3.0), leaf_ref(0, 1));
+            root.set(1, &slab(1.0, 2.0), leaf_ref(1, 1));
+            let w = wide_by_hand(&soup, vec![root], vec![block(&soup, &[0]), block(&soup, &[1])], 0, kernel);
+            assert_eq!(closest(&w, &soup, &ray), (Some((0, 0.5)), 2, 1), "axis {a} {kernel:?}");
+        }
+        for kernel in kernels(4) {
+            let mut root = WideNode::<4>::EMPTY_NODE;
+            root.set(0, &slab(2.0, 3.0), leaf_ref(0, 1));
+            root.set(1, &slab(1.0, 2.0), leaf_ref(1, 1));
+            let w = wide_by_hand(&soup, vec![root], vec![block(&soup, &[0]), block(&soup, &[1])], 0, kernel);
+            assert_eq!(closest(&w, &soup, &ray), (Some((0, 0.5)), 2, 1), "axis {a} {kernel:?} 4 wide");
         }
     }
 }
