@@ -757,3 +757,87 @@ fn statistics_report_by_hand() {
     let none = AccelStats { name: "none".into(), memory_bytes: 512, ..Default::default() };
     assert_eq!(none.to_string(), "none: 0 primitives, built in 0.00 ms\n  interior nodes 0, leaves 0, max depth 0\n  references 0 (0.00 per leaf), SAH cost 0.00\n  memory 0.5 KiB");
 }
+
+/// The portable kernel's triangle filter (`triangle_candidates`) and the SSE2 block test
+/// (`triangles_sse`) on one block, worked by hand. Lane 0: the triangle A = (0, 0),
+/// B = (4, 0), C = (0, 4) in the plane z = 0; lane 1: the same wound the other way; lane 2:
+/// a primitive that is not a triangle (always a candidate, always left to its own test);
+/// lane 3: empty (never). Rays along −z from z = 1 (t = 1 at z = 0) through points inside
+/// the triangle (kept), across each edge and beyond each vertex (one or two edge functions
+/// negative, the others positive, none zero: rejected, whatever the winding), and on an
+/// edge or its extension (an edge function exactly zero: kept for the exact kernel).
+#[test]
+fn triangle_filter_and_block_test_by_hand() {
+    use raylab_accel::wide::kernels::triangle_candidates;
+    use raylab_core::intersect::ShearedRay;
+    let p = |x: f32, y: f32| Vec3::new(x, y, 0.0);
+    let (a, b, c) = (p(0.0, 0.0), p(4.0, 0.0), p(0.0, 4.0));
+    let mut blk = TriBlock::EMPTY_BLOCK;
+    blk.set_triangle(0, 0, [a, b, c]);
+    blk.set_triangle(1, 1, [a, c, b]);
+    blk.prim[2] = 2 | TriBlock::OTHER;
+    // (point, kept by the filter, hit)
+    let cases = [
+        ((1.0, 1.0), true, true),    // inside
+        ((3.0, 0.5), true, true),    // inside, near the hypotenuse
+        ((1.0, -1.0), false, false), // across AB (y < 0)
+        ((-1.0, 1.0), false, false), // across AC (x < 0)
+        ((3.0, 3.0), false, false),  // across BC (x + y > 4)
+        ((-1.0, -1.0), false, false), // beyond A
+        ((6.0, -1.0), false, false), // beyond B (y < 0 and x + y > 4)
+        ((-1.0, 6.0), false, false), // beyond C
+        ((1.0, 0.0), true, true),    // on AB: a zero edge function
+        ((6.0, 0.0), true, false),   // on AB's extension past B: zero, so kept; a miss
+        ((0.0, 0.0), true, true),    // on the vertex A: two zero edge functions
+    ];
+    for ((x, y), kept, hit) in cases {
+        let ray = Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z);
+        let s = ShearedRay::new(&ray);
+        let want = if kept { 0b111 } else { 0b100 };
+        assert_eq!(triangle_candidates(&blk, &s), want, "filter at ({x}, {y})");
+        for l in 0..2 {
+            assert_eq!(s.triangle(0.0, f32::INFINITY, blk.vertex(l, 0), blk.vertex(l, 1), blk.vertex(l, 2)).map(|h| h.0), hit.then_some(1.0), "lane {l} at ({x}, {y})");
+        }
+        #[cfg(target_arch = "x86_64")]
+        {
+            use raylab_accel::wide::kernels::triangles_sse;
+            let h = triangles_sse(&blk, &s, 0.0, f32::INFINITY);
+            // A zero edge function leaves the lane to the exact kernel; the non-triangle
+            // lane always goes there; the empty lane never.
+            let on_edge = x == 0.0 || y == 0.0;
+            let want_exact = if on_edge { 0b111 } else { 0b100 };
+            assert_eq!((h.hit, h.exact), (if hit && !on_edge { 0b11 } else { 0 }, want_exact), "SSE at ({x}, {y})");
+            if hit && !on_edge {
+                assert_eq!((h.t[0], h.t[1]), (1.0, 1.0));
+                // Barycentrics of (x, y): weights x/4 of B and y/4 of C, as two of u, v, 1 − u − v.
+                let mut w = [h.u[0], h.v[0], 1.0 - h.u[0] - h.v[0]];
+                w.sort_by(f32::total_cmp);
+                let mut want = [x / 4.0, y / 4.0, 1.0 - x / 4.0 - y / 4.0];
+                want.sort_by(f32::total_cmp);
+                assert_eq!(w, want, "barycentrics at ({x}, {y})");
+            }
+        }
+    }
+    // Oblique rays from z = 4 along (½, ¼, −1) reach z = 0 at t = 4, 2 and 1 further in x
+    // and y: the filter must test the sheared point, not the origin's (x, y) or a wrongly
+    // sheared one. Hits 1 or ½ inside an edge are kept; a miss is rejected.
+    let d = Vec3::new(0.5, 0.25, -1.0);
+    for ((x, y), kept) in [((1.0, 1.0), true), ((3.0, 0.5), true), ((0.5, 3.0), true), ((-1.0, -1.0), false), ((3.0, 3.0), false)] {
+        let ray = Ray::new(Vec3::new(x - 2.0, y - 1.0, 4.0), d);
+        let s = ShearedRay::new(&ray);
+        assert_eq!(triangle_candidates(&blk, &s), if kept { 0b111 } else { 0b100 }, "oblique filter at ({x}, {y})");
+        #[cfg(target_arch = "x86_64")]
+        {
+            let h = raylab_accel::wide::kernels::triangles_sse(&blk, &s, 0.0, f32::INFINITY);
+            assert_eq!((h.hit, h.exact), (if kept { 0b11 } else { 0 }, 0b100), "oblique SSE at ({x}, {y})");
+            if kept {
+                assert_eq!((h.t[0], h.t[1]), (4.0, 4.0));
+            }
+            // Beyond t_max, or not beyond t_min: decided, not hit.
+            let h = raylab_accel::wide::kernels::triangles_sse(&blk, &s, 0.0, 3.5);
+            assert_eq!((h.hit, h.exact), (0, 0b100));
+            let h = raylab_accel::wide::kernels::triangles_sse(&blk, &s, 4.0, 8.0);
+            assert_eq!((h.hit, h.exact), (0, 0b100));
+        }
+    }
+}
