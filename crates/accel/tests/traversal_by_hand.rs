@@ -841,3 +841,64 @@ fn triangle_filter_and_block_test_by_hand() {
         }
     }
 }
+
+/// A soup that counts calls to `Primitives::intersect`.
+struct Counting<'a> {
+    soup: &'a Soup,
+    calls: std::sync::atomic::AtomicUsize,
+}
+
+impl Primitives for Counting<'_> {
+    fn len(&self) -> usize {
+        self.soup.len()
+    }
+    fn bounds(&self, i: u32) -> Aabb {
+        pb(self.soup, i)
+    }
+    fn intersect(&self, i: u32, ray: &Ray) -> Option<raylab_accel::PrimHit> {
+        self.calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        self.soup.intersect(i, ray)
+    }
+    fn triangle(&self, i: u32) -> Option<[Vec3; 3]> {
+        self.soup.triangle(i)
+    }
+}
+
+/// Wide BVHs test the triangles copied into their blocks themselves: `Primitives::intersect`
+/// is called only for lanes that are not triangles (the sphere of the several-blocks scene,
+/// once per ray that reaches its block), with every kernel, single rays and packets.
+#[test]
+fn wide_bvh_calls_intersect_only_for_non_triangles() {
+    let a = 0;
+    let mut soup = Soup::triangles([near_half(a, 3.0, -16.0, -16.0), far_half(a, 2.0, -16.0, -16.0), near_half(a, 5.0, -16.0, -16.0), near_half(a, 1.0, -16.0, -16.0)]);
+    soup.prims.push(Prim::Sphere { center: at(a, 8.0, -4.0, -2.0), radius: 1.0 });
+    let counting = Counting { soup: &soup, calls: 0.into() };
+    let calls = || counting.calls.swap(0, std::sync::atomic::Ordering::Relaxed);
+    for kernel in kernels(8) {
+        let mut root = WideNode::<8>::EMPTY_NODE;
+        root.set(0, &union(&soup, &[0, 1, 2]), leaf_ref(0, 1));
+        root.set(1, &pb(&soup, 4).union(pb(&soup, 3)), leaf_ref(1, 1));
+        let n = soup.len() as u32;
+        let bin = Bvh::from_parts(vec![BvhNode::leaf(soup.bounds(), 0, n)], (0..n).collect(), n as usize, "one leaf");
+        let mut w = WideBvh::<8>::from_binary(&bin, &counting, "by hand").with_kernel(kernel);
+        (w.nodes, w.blocks, w.root) = (vec![root], vec![block(&soup, &[1, 0, 2]), block(&soup, &[4, 3])], 0);
+        // +a at (−4, −2) from c = 0: leaf 0 (c ∈ [2, 5], entry 2) and leaf 1 (c ∈ [1, 9],
+        // entry 1): leaf 1 first, prim 3 at t = 1 and the sphere (entered at c = 7) tested
+        // by its own test: one call; leaf 0 dropped.
+        let up = axis_ray(a, 1.0, 0.0, -4.0, -2.0, f32::INFINITY);
+        assert_eq!(w.intersect(&counting, &up, &mut Counters::default()).map(|h| (h.prim, h.t)), Some((3, 1.0)), "{kernel:?}");
+        assert_eq!(calls(), 1, "{kernel:?}: the sphere only");
+        // At (−4, 10): (u + 16) + (v + 16) = 38 > 32, so the near halves are missed and the
+        // far half (prim 1, c = 2) is hit at t = 2. Closest hit: leaf 1 (entry 1) first, its
+        // sphere lane is tested by a call (missed: v ∈ [−3, −1]), then leaf 0: one call. Any
+        // hit: leaf 0 first (the lower lane), prim 1 hit, no call. The packet of two rays:
+        // one call per ray in leaf 1.
+        let side = axis_ray(a, 1.0, 0.0, -4.0, 10.0, f32::INFINITY);
+        assert_eq!(w.intersect(&counting, &side, &mut Counters::default()).map(|h| (h.prim, h.t)), Some((1, 2.0)), "{kernel:?}");
+        assert!(w.occluded(&counting, &side, &mut Counters::default()));
+        let mut out = [None, None];
+        w.intersect_packet(&counting, &[side, side], &mut out);
+        assert_eq!(out.map(|h| h.map(|h| h.prim)), [Some(1); 2]);
+        assert_eq!(calls(), 1 + 2, "{kernel:?}: the sphere lane, three times");
+    }
+}
