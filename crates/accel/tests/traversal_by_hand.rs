@@ -376,6 +376,10 @@ fn scene_w_rays(a: usize) -> Vec<(Ray, Answer, (bool, u64, u64))> {
         // +a from c = 1.5 (between planes): lane 2 and lane 5 behind; lanes 0 (t = ½),
         // 3 (1½), 1 (2½): lane 0 hits at ½.
         (axis_ray(a, 1.0, 1.5, -4.0, -2.0, inf), (Some((0, 0.5)), 2, 1), (true, 2, 1)),
+        // +a at (10, 12), where (u + 16) + (v + 16) = 54 > 32: the near halves are missed,
+        // lane 5's far half is hit at t = ½ (entered first: 2 visits). Any hit enters lane 0
+        // (missed), then pops the highest stacked lane, 5: a hit, 3 visits and 2 tests.
+        (axis_ray(a, 1.0, 0.0, 10.0, 12.0, inf), (Some((5, 0.5)), 2, 1), (true, 3, 2)),
         // +a ending exactly on lane 2's plane (t_max = 1): its box is entered at t_max,
         // within the closed interval: as the first ray (lane 5, then lane 2 at t = 1).
         (axis_ray(a, 1.0, 0.0, -4.0, -2.0, 1.0), (Some((2, 1.0)), 3, 2), (true, 2, 1)),
