@@ -978,3 +978,45 @@ fn wide_validation_finds_each_broken_invariant() {
     let empty = Soup::default();
     assert!(AnyAccel::build(AccelKind::Bvh8, &empty, &BuildOptions::default()).validate(&empty).is_ok());
 }
+
+/// Packets prune by each ray's far limit, `t_max·(1 + 2γ₃)`, kept up to date with its hits:
+/// seen through the calls to `Primitives::intersect` that a sphere behind them costs. Leaf A
+/// (lane 0): prim 0, the far half of the square at c = 1 (hit at (u, v) = (10, 12), where
+/// (u + 16) + (v + 16) = 54 ≥ 32); leaf B (lane 1): prim 1, a sphere of radius ½ at c = 2,
+/// (u, v) = (10, 12), its box entered at c = 1.5. Rays along +a at (10, 12).
+#[test]
+fn packets_prune_by_each_rays_far_limit() {
+    let a = 0;
+    let mut soup = Soup::triangles([far_half(a, 1.0, -16.0, -16.0)]);
+    soup.prims.push(Prim::Sphere { center: at(a, 2.0, 10.0, 12.0), radius: 0.5 });
+    let counting = Counting { soup: &soup, calls: 0.into() };
+    let calls = || counting.calls.swap(0, std::sync::atomic::Ordering::Relaxed);
+    for kernel in kernels(8) {
+        let mut root = WideNode::<8>::EMPTY_NODE;
+        root.set(0, &pb(&soup, 0), leaf_ref(0, 1));
+        root.set(1, &pb(&soup, 1), leaf_ref(1, 1));
+        let n = soup.len() as u32;
+        let bin = Bvh::from_parts(vec![BvhNode::leaf(soup.bounds(), 0, n)], (0..n).collect(), n as usize, "one leaf");
+        let mut w = WideBvh::<8>::from_binary(&bin, &counting, "by hand").with_kernel(kernel);
+        (w.nodes, w.blocks, w.root) = (vec![root], vec![block(&soup, &[0]), block(&soup, &[1])], 0);
+        // Ending at t = 0.9: neither box is entered (1 and 1.5 > 0.9·(1 + 2γ₃)): no call.
+        let short = axis_ray(a, 1.0, 0.0, 10.0, 12.0, 0.9);
+        // Unbounded: prim 0 at t = 1, after which leaf B (entry 1.5 > 1·(1 + 2γ₃)) is
+        // dropped: no call.
+        let hit = axis_ray(a, 1.0, 0.0, 10.0, 12.0, f32::INFINITY);
+        // From c = 1.25, past the triangle: leaf B only, the sphere at t = 0.25: one call.
+        let past = axis_ray(a, 1.0, 1.25, 10.0, 12.0, f32::INFINITY);
+        let mut out = [None; 3];
+        w.intersect_packet(&counting, &[short, hit, past], &mut out);
+        assert_eq!(out.map(|h| h.map(|h| h.prim)), [None, Some(0), Some(1)], "{kernel:?}");
+        assert_eq!(out[1].unwrap().t, 1.0);
+        assert!((out[2].unwrap().t - 0.25).abs() < 1e-6);
+        // The packet enters leaf B first (its least entry, 0.25, is the ray past the
+        // triangle's) with both unbounded rays, before `hit` has found prim 0: two calls.
+        assert_eq!(calls(), 2, "{kernel:?}: leaf B first, for two rays");
+        // Without `past`, leaf A (entry 1) comes first: `hit` finds prim 0, and leaf B is
+        // then dropped for it; `short` entered neither: no call.
+        w.intersect_packet(&counting, &[short, hit], &mut out[..2]);
+        assert_eq!(calls(), 0, "{kernel:?}");
+    }
+}
