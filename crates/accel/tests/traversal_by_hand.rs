@@ -1020,3 +1020,38 @@ fn packets_prune_by_each_rays_far_limit() {
         assert_eq!(calls(), 0, "{kernel:?}");
     }
 }
+
+/// Statistics of the several-blocks scene (axis x): its box (the scene's) is c ∈ [1, 9] ×
+/// 32 × 32, half area 8·32 + 32·32 + 32·8 = 1536; leaf A has the same box, 5 primitives in
+/// 2 blocks (charged 2), leaf B a flat square (1024) of 1 in 1 block: SAH = 1 + 2 +
+/// 1024/1536; one node and three blocks, 224 + 3·160 bytes. Built through `AnyAccel`, a
+/// wide BVH reports its build time; SBVH-based ones accept leaves their primitives stick
+/// out of.
+#[test]
+fn wide_statistics_of_leaves_of_several_blocks() {
+    let a = 0;
+    let mut soup = Soup::triangles([near_half(a, 3.0, -16.0, -16.0), far_half(a, 2.0, -16.0, -16.0), near_half(a, 5.0, -16.0, -16.0), near_half(a, 1.0, -16.0, -16.0)]);
+    soup.prims.push(Prim::Sphere { center: at(a, 8.0, -4.0, -2.0), radius: 1.0 });
+    soup.prims.push(Prim::Triangle(near_half(a, 6.0, -16.0, -16.0)));
+    let mut root = WideNode::<8>::EMPTY_NODE;
+    root.set(0, &union(&soup, &[0, 1, 2, 3, 4]), leaf_ref(1, 2));
+    root.set(1, &pb(&soup, 5), leaf_ref(0, 1));
+    let w = wide_by_hand(&soup, vec![root], vec![block(&soup, &[5]), block(&soup, &[1, 0, 2]), block(&soup, &[4, 3])], 0, Kernel::Portable);
+    let s = w.stats();
+    assert_eq!((s.interior_nodes, s.leaves, s.references, s.max_depth, s.memory_bytes), (1, 2, 6, 2, 224 + 3 * 160));
+    assert_eq!(s.leaf_histogram[..6], [0, 1, 0, 0, 0, 1]);
+    assert!((s.sah_cost - (3.0 + 1024.0 / 1536.0)).abs() < 1e-9, "{}", s.sah_cost);
+    // A leaf reference past the blocks (blocks 1..4 of 3: 1 + 3 > 3, where 1·3 is not) is
+    // reported, not followed.
+    let mut t = w;
+    t.nodes[0].child[1] = leaf_ref(1, 3);
+    assert_eq!(t.validate(&soup).unwrap_err().message, "leaf 0x90000001 points past the blocks");
+    let cube = raylab_testkit::cube();
+    for kind in [AccelKind::Bvh8, AccelKind::Bvh8Sbvh, AccelKind::Bvh8Q, AccelKind::Bvh4] {
+        let accel = AnyAccel::build(kind, &cube, &BuildOptions::default());
+        accel.validate(&cube).unwrap_or_else(|e| panic!("{kind}: {e}"));
+        let s = accel.stats();
+        assert!(s.build_ms > 0.0, "{kind}: the build time is reported");
+        assert_eq!((s.name.as_str(), s.primitives, s.references), (kind.name(), 12, 12));
+    }
+}
