@@ -1021,6 +1021,39 @@ fn packets_prune_by_each_rays_far_limit() {
     }
 }
 
+/// Packets take children nearest first by their least entry, whatever their lanes: lane 0
+/// holds a sphere at c = 3.5 (box entered at 3), lane 1 the sphere at c = 2 (1.5), lane 2
+/// the far half at c = 1 (1). The ray at (10, 12) (with the spheres on it) meets the far
+/// half first, at t = 1, and both spheres are then dropped: no call, with three children
+/// (the sort) and, ending at t = 2.5, two (lane 0 not entered). Any other order tests a
+/// sphere first.
+#[test]
+fn packets_take_children_nearest_first() {
+    let a = 0;
+    let mut soup = Soup::triangles([far_half(a, 1.0, -16.0, -16.0)]);
+    soup.prims.push(Prim::Sphere { center: at(a, 2.0, 10.0, 12.0), radius: 0.5 });
+    soup.prims.push(Prim::Sphere { center: at(a, 3.5, 10.0, 12.0), radius: 0.5 });
+    let counting = Counting { soup: &soup, calls: 0.into() };
+    let calls = || counting.calls.swap(0, std::sync::atomic::Ordering::Relaxed);
+    for kernel in kernels(8) {
+        let mut root = WideNode::<8>::EMPTY_NODE;
+        root.set(0, &pb(&soup, 2), leaf_ref(2, 1));
+        root.set(1, &pb(&soup, 1), leaf_ref(1, 1));
+        root.set(2, &pb(&soup, 0), leaf_ref(0, 1));
+        let n = soup.len() as u32;
+        let bin = Bvh::from_parts(vec![BvhNode::leaf(soup.bounds(), 0, n)], (0..n).collect(), n as usize, "one leaf");
+        let mut w = WideBvh::<8>::from_binary(&bin, &counting, "by hand").with_kernel(kernel);
+        (w.nodes, w.blocks, w.root) = (vec![root], vec![block(&soup, &[0]), block(&soup, &[1]), block(&soup, &[2])], 0);
+        for t_max in [f32::INFINITY, 2.5] {
+            let ray = axis_ray(a, 1.0, 0.0, 10.0, 12.0, t_max);
+            let mut out = [None; 2];
+            w.intersect_packet(&counting, &[ray, ray], &mut out);
+            assert_eq!(out.map(|h| h.map(|h| (h.prim, h.t))), [Some((0, 1.0)); 2], "{kernel:?} t_max {t_max}");
+            assert_eq!(calls(), 0, "{kernel:?} t_max {t_max}: the far half first");
+        }
+    }
+}
+
 /// Statistics of the several-blocks scene (axis x): its box (the scene's) is c ∈ [1, 9] ×
 /// 32 × 32, half area 8·32 + 32·32 + 32·8 = 1536; leaf A has the same box, 5 primitives in
 /// 2 blocks (charged 2), leaf B a flat square (1024) of 1 in 1 block: SAH = 1 + 2 +
