@@ -337,7 +337,7 @@ fn scene_w_tree<const W: usize>(soup: &Soup, kernel: Kernel) -> WideBvh<W> {
     let mut root = WideNode::<W>::EMPTY_NODE;
     let lanes = W.min(7);
     for l in 0..lanes {
-        root.set(l, &pb(&soup, l as u32), leaf_ref(l, 1));
+        root.set(l, &pb(soup, l as u32), leaf_ref(l, 1));
     }
     let blocks = (0..lanes as u32).map(|p| block(soup, &[p])).collect();
     wide_by_hand(soup, vec![root], blocks, 0, kernel)
