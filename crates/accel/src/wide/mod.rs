@@ -177,15 +177,19 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
         traverse::any::<P, W, N, false, COUNT>(self, prims, ray, c)
     }
 
-    /// Calls `f(reference, bounds, depth)` for every child reference, depth first.
+    /// Calls `f(reference, bounds, depth)` for every child reference, depth first. A node
+    /// is entered once, and only if it exists: on a broken tree (a cycle, a reference past
+    /// the nodes) `f` still sees the reference, which validation reports, and the walk ends.
     fn walk(&self, mut f: impl FnMut(ChildRef, &Aabb, usize)) {
         if self.root == EMPTY {
             return;
         }
+        let mut entered = vec![false; self.nodes.len()];
         let mut stack = vec![(self.root, self.root_bounds, 1usize)];
         while let Some((r, b, depth)) = stack.pop() {
             f(r, &b, depth);
-            if !is_leaf(r) {
+            if !is_leaf(r) && entered.get(r as usize).is_some_and(|e| !e) {
+                entered[r as usize] = true;
                 self.nodes[r as usize].with_decoded(|n| {
                     for lane in 0..W {
                         if n.child[lane] != EMPTY {
