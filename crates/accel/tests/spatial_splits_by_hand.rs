@@ -254,3 +254,49 @@ fn diagonal_segments_are_bounded_by_their_clipped_parts() {
     }
     b.validate(&s).unwrap();
 }
+
+#[test]
+fn sah_split_of_a_parent_without_area() {
+    use raylab_accel::bvh::SahCost;
+    // A parent on a line (2 x 0 x 0: half area 2·0 + 0·0 + 0·2 = 0): every ray that hits it
+    // hits both children, so the split costs T + I·(n_left + n_right) = 0.5 + 2·(2 + 3) =
+    // 10.5 whatever the children. (A unit square is not such a parent: its half area is 1.)
+    let sah = SahCost { traversal: 0.5, intersection: 2.0 };
+    let line = Aabb::new(Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0));
+    let half = Aabb::new(Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0));
+    assert_eq!(line.half_area(), 0.0);
+    assert_eq!(sah.split(&line, &half, 2, &half, 3), 10.5);
+    assert_eq!(sah.split(&line, &line, 4, &half, 0), 8.5);
+    // A point: 0.5 + 2·1.
+    let point = Aabb::new(Vec3::ONE, Vec3::ONE);
+    assert_eq!(sah.split(&point, &point, 1, &point, 0), 2.5);
+}
+
+#[test]
+fn the_duplication_budget_is_shared_by_counts_and_spent_in_order() {
+    // Unit squares 0 at x 0..1 and 1 at x 7..8, and two long boxes 2 and 3 over 0..8 (y 0..1
+    // throughout); leaf size 1, so every node of two or more splits, the cheaper way.
+    // Costs below are X in T + I·X, X = Σ(half area · count) / parent half area.
+    // Root (8 x 1, budget 4 = one duplicate per primitive): object split {0} | {1, 2, 3}
+    // X = (1·1 + 8·3)/8 = 3.125; spatial at x = 4 (3 references enter [0, 4], 3 leave
+    // [4, 8]) X = (4·3 + 4·3)/8 = 3: both long boxes are cut (halves 4·3 + 4·3 = 24 against
+    // 8·3 + 4·2 = 32 for either whole). 2 duplicates leave 2, shared by counts 3 and 3:
+    // 2·3/6 = 1 to the left child, 2 − 1 = 1 to the right.
+    // Left child {0, 2 [0, 4], 3 [0, 4]}: object {0} | {2, 3} X = (1·1 + 4·2)/4 = 2.25 beats
+    // spatial at x = 2 (X = (2·3 + 2·2)/4 = 2.5); budget 1 split 1·1/3 = 0 and 1.
+    // {2, 3} over [0, 4] with budget 1: no object split (same centroids); spatial at x = 2
+    // (x and y tie at X = 2, x first): box 2 is cut, the budget is then spent and box 3 is
+    // kept whole, on the left (a tie: 4·2 + 2·1 = 2·1 + 4·2). Children {2 [0, 2], 3} (no
+    // budget: object split by centroids 1 < 2) and {2 [2, 4]}.
+    // Right child {1, 2 [4, 8], 3 [4, 8]}: object {2, 3} | {1} (X = 2.25); budget 1 split
+    // 1·2/3 = 0 and 1: {2, 3} over [4, 8] has no budget, no object split: halved by index.
+    let prims = Boxes(vec![rect(0.0, 1.0, 0.0, 1.0), rect(7.0, 8.0, 0.0, 1.0), rect(0.0, 8.0, 0.0, 1.0), rect(0.0, 8.0, 0.0, 1.0)]);
+    let b = sbvh::build(&prims, &opts(1.0, 1.0, 1, 2, 1e-5));
+    assert_eq!(shape(&b), "((0 ((2 3) 2)) ((2 3) 1))");
+    assert_eq!(b.stats().references, 7);
+    let want = [rect(0.0, 1.0, 0.0, 1.0), rect(0.0, 2.0, 0.0, 1.0), rect(0.0, 4.0, 0.0, 1.0), rect(2.0, 4.0, 0.0, 1.0), rect(4.0, 8.0, 0.0, 1.0), rect(4.0, 8.0, 0.0, 1.0), rect(7.0, 8.0, 0.0, 1.0)];
+    for (got, want) in leaf_boxes(&b).into_iter().zip(want) {
+        assert_box(got, grown(want, 8.0), "leaf");
+    }
+    b.validate(&prims).unwrap();
+}
