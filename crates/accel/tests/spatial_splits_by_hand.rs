@@ -300,3 +300,36 @@ fn the_duplication_budget_is_shared_by_counts_and_spent_in_order() {
     }
     b.validate(&prims).unwrap();
 }
+
+/// Point boxes (zero extent on every axis) at the given x.
+fn points(xs: impl IntoIterator<Item = f32>) -> Boxes {
+    Boxes(xs.into_iter().map(|x| Aabb::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x, 0.0, 0.0))).collect())
+}
+
+#[test]
+fn coincident_references_are_halved_by_index() {
+    // Five points at the same place: no object split (one centroid), no spatial split (no
+    // axis has extent), so a node larger than the leaf size (2) is halved by position:
+    // {0, 1} | {2, 3, 4}, then {2} | {3, 4}.
+    let b = sbvh::build(&points([5.0; 5]), &opts(1.0, 1.0, 2, 2, 1e-5));
+    assert_eq!(shape(&b), "([0 1] (2 [3 4]))");
+    assert_eq!(shape(&sbvh::build(&points([5.0; 5]), &opts(1.0, 1.0, 5, 2, 1e-5))), "[0 1 2 3 4]");
+}
+
+#[test]
+fn sbvh_chains_are_cut_at_depth_64() {
+    // Points at x = 3^k, k = 0..=70, leaf size 1, 2 bins. The scene is a line (half area 0),
+    // so every split costs T + I·n, never below a leaf: nodes split only because they are
+    // too large, along x at the one plane, the middle of the centroids' range; every point
+    // but the largest lies below it (3^(k-1) < 3^k / 2). No spatial split is tried (the
+    // children's overlap has no area, not above α times the root's 0). So each level peels
+    // off the largest point: the node at depth d holds 72 - d points, until the node at
+    // depth 64 becomes a leaf of 8: 63 interior nodes and 64 leaves.
+    let prims = points((0..=70).map(|k| 3f32.powi(k)));
+    let b = sbvh::build(&prims, &opts(1.0, 1.0, 1, 2, 1e-5));
+    let s = b.stats();
+    assert_eq!((s.max_depth, s.interior_nodes, s.leaves, s.references), (64, 63, 64, 71));
+    assert_eq!(s.leaf_histogram[1], 63);
+    assert_eq!(s.leaf_histogram[8], 1);
+    b.validate(&prims).unwrap();
+}
