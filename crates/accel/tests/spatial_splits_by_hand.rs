@@ -333,3 +333,20 @@ fn sbvh_chains_are_cut_at_depth_64() {
     assert_eq!(s.leaf_histogram[8], 1);
     b.validate(&prims).unwrap();
 }
+
+#[test]
+fn sbvh_chains_built_in_parallel_are_cut_at_depth_64_too() {
+    // As above, with 4100 more points at the chain's low end, so that every node of the
+    // chain holds at least 4096 references and builds its children through `rayon::join`.
+    // Mirrored (x = -3^k, extras at -0.5), the chain runs down the right children instead.
+    for sign in [1.0f32, -1.0] {
+        let xs: Vec<f32> = (0..=70).map(|k| sign * 3f32.powi(k)).chain(std::iter::repeat_n(sign * 0.5, 4100)).collect();
+        let prims = points(xs);
+        let b = sbvh::build(&prims, &opts(1.0, 1.0, 1, 2, 1e-5));
+        let s = b.stats();
+        // Depth 64 holds 8 chain points and the 4100 extras: one leaf of 4108.
+        assert_eq!((s.max_depth, s.interior_nodes, s.leaves, s.references), (64, 63, 64, 4171), "sign {sign}");
+        assert_eq!((s.leaf_histogram[1], *s.leaf_histogram.last().unwrap()), (63, 1), "sign {sign}");
+        b.validate(&prims).unwrap();
+    }
+}
