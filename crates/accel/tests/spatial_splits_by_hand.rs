@@ -324,14 +324,16 @@ fn sbvh_chains_are_cut_at_depth_64() {
     // but the largest lies below it (3^(k-1) < 3^k / 2). No spatial split is tried (the
     // children's overlap has no area, not above α times the root's 0). So each level peels
     // off the largest point: the node at depth d holds 72 - d points, until the node at
-    // depth 64 becomes a leaf of 8: 63 interior nodes and 64 leaves.
-    let prims = points((0..=70).map(|k| 3f32.powi(k)));
-    let b = sbvh::build(&prims, &opts(1.0, 1.0, 1, 2, 1e-5));
-    let s = b.stats();
-    assert_eq!((s.max_depth, s.interior_nodes, s.leaves, s.references), (64, 63, 64, 71));
-    assert_eq!(s.leaf_histogram[1], 63);
-    assert_eq!(s.leaf_histogram[8], 1);
-    b.validate(&prims).unwrap();
+    // depth 64 becomes a leaf of 8: 63 interior nodes and 64 leaves. Mirrored (x = -3^k),
+    // the chain runs down the right children.
+    for sign in [1.0f32, -1.0] {
+        let prims = points((0..=70).map(|k| sign * 3f32.powi(k)));
+        let b = sbvh::build(&prims, &opts(1.0, 1.0, 1, 2, 1e-5));
+        let s = b.stats();
+        assert_eq!((s.max_depth, s.interior_nodes, s.leaves, s.references), (64, 63, 64, 71), "sign {sign}");
+        assert_eq!((s.leaf_histogram[1], s.leaf_histogram[8]), (63, 1), "sign {sign}");
+        b.validate(&prims).unwrap();
+    }
 }
 
 #[test]
