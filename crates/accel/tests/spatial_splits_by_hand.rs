@@ -352,3 +352,18 @@ fn sbvh_chains_built_in_parallel_are_cut_at_depth_64_too() {
         b.validate(&prims).unwrap();
     }
 }
+
+#[test]
+fn an_object_split_that_ties_with_the_spatial_one_is_kept() {
+    // Scene A with square 0 shrunk to the segment x = 8, y 0..1 (no area). T = 1, I = 2;
+    // α = -1 so that spatial splits are tried although the object split's children overlap
+    // only in that segment (no area). Object split {0} | {1, 2}: X = (0·1 + 4·2)/4 = 2;
+    // spatial at x = 10 (bins [8, 10] and [10, 12], two references each): X = (2·2 + 2·2)/4
+    // = 2, a tie, which keeps the object split (a spatial split only when strictly cheaper).
+    // Then {1, 2}: object (2 1) at X = (4·1 + 1·1)/4 = 1.25 against spatial (2·1 + 2·2)/4 =
+    // 1.5 and the leaf's 2: cost 3.5 < 4.
+    let prims = Boxes(vec![rect(8.0, 8.0, 0.0, 1.0), rect(11.0, 12.0, 0.0, 1.0), rect(8.0, 12.0, 0.0, 1.0)]);
+    let b = sbvh::build(&prims, &opts(1.0, 2.0, 8, 2, -1.0));
+    assert_eq!(shape(&b), "(0 (2 1))");
+    assert_eq!(b.stats().references, 3);
+}
