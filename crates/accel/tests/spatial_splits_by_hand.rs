@@ -367,3 +367,36 @@ fn an_object_split_that_ties_with_the_spatial_one_is_kept() {
     assert_eq!(shape(&b), "(0 (2 1))");
     assert_eq!(b.stats().references, 3);
 }
+
+#[test]
+fn object_planes_that_tie_keep_the_first() {
+    // Unit squares at x 0..1, 2..3 and 4..5; 4 bins over the centroids [0.5, 4.5] (width 1)
+    // put them in bins 0, 2 and 3. Σ(half area · count): plane 1 {0} | {1, 2} = 1·1 + 3·2 = 7,
+    // plane 2 the same sets, plane 3 {0, 1} | {2} = 3·2 + 1·1 = 7: a tie, kept on plane 1.
+    // T = I = 1: 1 + 7/5 = 2.4 beats the leaf's 3; the children's boxes do not overlap, so no
+    // spatial split is tried. Then {1, 2}: 1 + (1 + 1)/3 < 2.
+    let prims = Boxes(vec![rect(0.0, 1.0, 0.0, 1.0), rect(2.0, 3.0, 0.0, 1.0), rect(4.0, 5.0, 0.0, 1.0)]);
+    assert_eq!(shape(&sbvh::build(&prims, &opts(1.0, 1.0, 8, 4, 1e-5))), "(0 (1 2))");
+}
+
+#[test]
+fn a_spatial_split_that_sends_everything_one_way_is_dropped() {
+    // Two copies of the box [0, 8] x [0, 1] x [0, 1] (half area 8 + 1 + 8 = 17), leaf size 1,
+    // 16 bins. No object split (same centroids). Spatial planes along x all cost the same,
+    // Σ = 2·(2a + 1) + 2·(2(8 - a) + 1) = 36 at x = a (along y or z: 50), so the first,
+    // x = 0.5, is taken. Unsplitting each copy: cut, 2·2 + 16·2 = 36 ([0, 0.5] has half area
+    // 0.5 + 1 + 0.5 = 2, [0.5, 8] 16); whole on the left 17·2 + 16·1 = 50; whole on the
+    // right 2·1 + 17·2 = 36, a tie with cutting, which keeps the copy whole: both go right,
+    // the left side is empty, so the split is dropped and the node halved by index: two
+    // leaves bounding the whole boxes.
+    let prims = Boxes(vec![Aabb::new(Vec3::ZERO, Vec3::new(8.0, 1.0, 1.0)); 2]);
+    let b = sbvh::build(&prims, &opts(1.0, 1.0, 1, 16, 1e-5));
+    assert_eq!(shape(&b), "(0 1)");
+    let s = b.stats();
+    assert_eq!((s.leaves, s.references, s.max_depth), (2, 2, 2));
+    // Grown by 8 / 2¹⁸ = 2⁻¹⁵.
+    let m = 1.0 / 32_768.0;
+    let whole = Aabb::new(Vec3::splat(-m), Vec3::new(8.0 + m, 1.0 + m, 1.0 + m));
+    assert_eq!(leaf_boxes(&b), [whole, whole]);
+    b.validate(&prims).unwrap();
+}
