@@ -76,7 +76,9 @@ impl SphereBvh {
         Self { nodes, indices, primitives: n, build_ms: 0.0 }
     }
 
-    /// Visits every node with its depth (root depth 1).
+    /// Visits every node with its depth (root depth 1). Only children stored after their
+    /// parent are followed, so that a broken tree whose children point back cannot make the
+    /// walk loop for ever (`validate` reports them).
     fn visit(&self, mut f: impl FnMut(usize, usize)) {
         if self.nodes.is_empty() {
             return;
@@ -85,7 +87,7 @@ impl SphereBvh {
         while let Some((i, depth)) = stack.pop() {
             f(i, depth);
             let n = &self.nodes[i];
-            if !n.is_leaf() && (n.left_first as usize) + 1 < self.nodes.len() {
+            if !n.is_leaf() && (n.left_first as usize) > i && (n.left_first as usize) + 1 < self.nodes.len() {
                 stack.push((n.left_first as usize, depth + 1));
                 stack.push((n.left_first as usize + 1, depth + 1));
             }
@@ -194,5 +196,91 @@ impl Accel for SphereBvh {
             return err(format!("primitive {p} is in {} leaves, not one", seen[p]));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! `validate` on trees built by hand (the fields are private, so these cannot be made
+    //! outside), and the containment test against values worked out by hand. (Issue 15.)
+    use super::*;
+    use crate::PrimHit;
+
+    /// Unit cubes at x = 10 + 3k as primitives.
+    struct Cubes(usize);
+
+    impl Primitives for Cubes {
+        fn len(&self) -> usize {
+            self.0
+        }
+        fn bounds(&self, i: u32) -> Aabb {
+            let x = 10.0 + 3.0 * i as f32;
+            Aabb::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x + 1.0, 1.0, 1.0))
+        }
+        fn intersect(&self, _: u32, _: &Ray) -> Option<PrimHit> {
+            None
+        }
+    }
+
+    /// A node whose sphere (centre (13, 0.5, 0.5), radius 10) holds every cube used here.
+    fn node(left_first: u32, count: u32) -> SphereNode {
+        SphereNode { center: [13.0, 0.5, 0.5], radius: 10.0, left_first, count }
+    }
+
+    fn check(nodes: Vec<SphereNode>, indices: Vec<u32>, n: usize) -> Result<(), String> {
+        SphereBvh { nodes, indices, primitives: n, build_ms: 0.0 }.validate(&Cubes(n)).map_err(|e| e.message)
+    }
+
+    #[test]
+    fn sphere_containment_by_hand() {
+        let outer = BoundingSphere { center: Vec3::new(5.0, 0.0, 0.0), radius: 2.0 };
+        let at = |x: f32, radius: f32| BoundingSphere { center: Vec3::new(x, 0.0, 0.0), radius };
+        // Touching from inside: distance 1 + radius 1 = 2, the outer radius.
+        assert!(sphere_contains(&outer, &at(6.0, 1.0)));
+        // Within the relative slack 10⁻⁵ (2 · 10⁻⁵ = 2e-5 here): 1 + 1.00001 ≤ 2.00002.
+        assert!(sphere_contains(&outer, &at(6.0, 1.00001)));
+        // Beyond it: 1 + 1.0001 > 2.00002; and entirely outside.
+        assert!(!sphere_contains(&outer, &at(6.0, 1.0001)));
+        assert!(!sphere_contains(&outer, &at(9.0, 0.5)));
+        assert!(sphere_contains(&outer, &at(4.0, 0.5)));
+    }
+
+    #[test]
+    fn validate_rejects_each_broken_tree() {
+        // A good tree: root over leaves {0} and {1}.
+        check(vec![node(1, 0), node(0, 1), node(1, 1)], vec![0, 1], 2).unwrap();
+        // Children past the end (1 + 1 = 2 nodes) or not after their parent.
+        assert_eq!(check(vec![node(1, 0), node(0, 2)], vec![0, 1], 2).unwrap_err(), "node 0 has children 1, 2 out of order or range");
+        assert_eq!(check(vec![node(0, 0), node(0, 1), node(1, 1)], vec![0, 1], 2).unwrap_err(), "node 0 has children 0, 1 out of order or range");
+        // A child sphere outside its parent's.
+        let mut small = vec![node(1, 0), node(0, 1), node(1, 1)];
+        small[0].radius = 1.0;
+        assert_eq!(check(small, vec![0, 1], 2).unwrap_err(), "child 1 sticks out of node 0");
+        let mut moved = vec![node(1, 0), node(0, 1), node(1, 1)];
+        moved[2].center[0] = 14.0;
+        assert_eq!(check(moved, vec![0, 1], 2).unwrap_err(), "child 2 sticks out of node 0");
+        // Leaves pointing past the indices, or at a primitive that does not exist.
+        assert_eq!(check(vec![node(1, 0), node(0, 1), node(1, 2)], vec![0, 1], 2).unwrap_err(), "leaf 2 points past the index array");
+        assert_eq!(check(vec![node(1, 0), node(0, 1), node(1, 1)], vec![0, 5], 2).unwrap_err(), "leaf 2 holds primitive 5 of 2");
+        // A primitive outside its leaf's sphere: cube 1 spans x 13..14, its corners lie √3/2 ≈
+        // 0.866 from its centre: a sphere of radius 0.8 there misses them, one of 0.9 holds them.
+        let mut tight = vec![node(1, 0), node(0, 1), node(1, 1)];
+        tight[2] = SphereNode { center: [13.5, 0.5, 0.5], radius: 0.8, left_first: 1, count: 1 };
+        assert_eq!(check(tight, vec![0, 1], 2).unwrap_err(), "primitive 1 sticks out of leaf 2");
+        let mut fits = vec![node(1, 0), node(0, 1), node(1, 1)];
+        fits[2] = SphereNode { center: [13.5, 0.5, 0.5], radius: 0.9, left_first: 1, count: 1 };
+        check(fits, vec![0, 1], 2).unwrap();
+        // Two interior nodes sharing children 3 and 4: node 4 is reached twice.
+        let shared = vec![node(1, 0), node(3, 0), node(3, 0), node(0, 1), node(1, 1)];
+        assert_eq!(check(shared, vec![0, 1], 2).unwrap_err(), "node 4 reached twice");
+        // A node no one points to, and a primitive in two leaves or in none.
+        assert_eq!(check(vec![node(1, 0), node(0, 1), node(1, 1), node(0, 1)], vec![0, 1], 2).unwrap_err(), "node 3 is unreachable");
+        assert_eq!(check(vec![node(1, 0), node(0, 1), node(1, 1)], vec![0, 0], 2).unwrap_err(), "primitive 0 is in 2 leaves, not one");
+        assert_eq!(check(vec![node(0, 1)], vec![0], 2).unwrap_err(), "primitive 1 is in 0 leaves, not one");
+        // Counts and emptiness.
+        assert_eq!(check(vec![], vec![], 2).unwrap_err(), "no nodes for a non-empty scene");
+        check(vec![], vec![], 0).unwrap();
+        let built = SphereBvh { nodes: vec![node(0, 1)], indices: vec![0], primitives: 1, build_ms: 0.0 };
+        assert_eq!(built.validate(&Cubes(2)).unwrap_err().message, "built for 1 primitives, given 2");
     }
 }
