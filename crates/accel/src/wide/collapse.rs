@@ -68,6 +68,8 @@ struct Plan<const W: usize> {
     split: [u8; W],
     /// When whole and not a leaf: the left child's share of the wide node's `W` slots.
     wide: u8,
+    /// The subtree's cost, whole (the root's is the tree's SAH cost, times the root's area).
+    cost: f32,
 }
 
 /// The dynamic programme, children before parents (a reverse sweep: children always sit
@@ -75,13 +77,14 @@ struct Plan<const W: usize> {
 /// slots of its parent; a wide node costs its area, a leaf its area times its blocks.
 fn plan<const W: usize>(bin: &[BvhNode], counts: &[usize]) -> Vec<Plan<W>> {
     let mut cost = vec![[0.0f32; W]; bin.len()];
-    let mut plan = vec![Plan { leaf: true, split: [0; W], wide: 0 }; bin.len()];
+    let mut plan = vec![Plan { leaf: true, split: [0; W], wide: 0, cost: 0.0 }; bin.len()];
     for i in (0..bin.len()).rev() {
         let n = &bin[i];
         let area = n.bounds().half_area().max(0.0);
         let as_leaf = area * counts[i].div_ceil(4) as f32;
         if n.is_leaf() {
             cost[i] = [as_leaf; W];
+            plan[i].cost = as_leaf;
             continue;
         }
         let (l, r) = (n.left_first as usize, n.left_first as usize + 1);
@@ -98,7 +101,7 @@ fn plan<const W: usize>(bin: &[BvhNode], counts: &[usize]) -> Vec<Plan<W>> {
         let as_node = area + spread[W - 1].0;
         let leaf = counts[i] <= LEAF_PRIMS && as_leaf <= as_node;
         let whole = if leaf { as_leaf } else { as_node };
-        let mut p = Plan { leaf, split: [0; W], wide: spread[W - 1].1 };
+        let mut p = Plan { leaf, split: [0; W], wide: spread[W - 1].1, cost: whole };
         cost[i][0] = whole;
         for j in 2..=W {
             let (c, k) = spread[j - 1];
@@ -219,7 +222,9 @@ mod tests {
     #[test]
     fn six_triangles_in_one_box_make_one_leaf() {
         let bin = [BvhNode::interior(aabb(1.0, 1.0, 1.0), 1), BvhNode::leaf(aabb(1.0, 1.0, 1.0), 0, 3), BvhNode::leaf(aabb(1.0, 1.0, 1.0), 3, 3)];
-        assert!(plan::<8>(&bin, &counts(&bin))[0].leaf);
+        let whole = plan::<8>(&bin, &counts(&bin));
+        assert!(whole[0].leaf);
+        assert_eq!(whole[0].cost, 6.0);
         // Small children, half area 0.25 each (0.5 × 0.5 × 0): as a node 3 + 0.25 + 0.25 = 3.5 < 6.
         let bin = [BvhNode::interior(aabb(1.0, 1.0, 1.0), 1), BvhNode::leaf(aabb(0.5, 0.5, 0.0), 0, 3), BvhNode::leaf(aabb(0.5, 0.5, 0.0), 3, 3)];
         assert!(!plan::<8>(&bin, &counts(&bin))[0].leaf);
@@ -243,10 +248,41 @@ mod tests {
             assert_eq!(bin[i].bounds().half_area(), want, "node {i}");
         }
         let plan = plan::<4>(&bin, &counts(&bin));
+        assert_eq!((plan[0].cost, plan[1].cost, plan[2].cost), (8.0, 6.0, 1.0));
         assert!(!plan[0].leaf && !plan[1].leaf, "20 and 16 references are too many for a leaf");
         assert_eq!(plan[0].wide, 2, "A takes two of R's four slots");
         assert_eq!(plan[1].split[1], 1, "A over two slots: one for each of its leaves");
         assert_eq!(plan[1].split[0], 0, "A in one slot stays whole");
         assert_eq!(plan[1].wide, 1);
+    }
+
+    /// Slots are counted on both sides. R (half area 3, 4 wide) over A (a leaf of four, half
+    /// area 1: cost 1) and B (half area 2) over C1 and C2 (half area 1.5 each), each over two
+    /// leaves of eight (half area 1, two blocks: 2 each). C whole: 1.5 + 2 + 2 = 5.5; spread
+    /// over two slots: 4. B over three slots: one C whole, the other spread, 5.5 + 4 = 9.5;
+    /// over four: 8; whole: 2 + 8 = 10 (two slots gain nothing: 5.5 + 5.5 > 10). R: A in one
+    /// slot and B over three, 1 + 9.5 = 10.5, against B over two (1 + 10) or one (1 + 10):
+    /// R costs 3 + 10.5 = 13.5. (Giving B a fourth slot, beyond R's four, would read 12.)
+    #[test]
+    fn slots_add_up_to_the_width() {
+        let (leaf, c) = (aabb(0.5, 0.5, 0.75), aabb(1.0, 1.0, 0.25));
+        let bin = [
+            BvhNode::interior(aabb(1.0, 1.0, 1.0), 1),
+            BvhNode::leaf(leaf, 0, 4),
+            BvhNode::interior(aabb(1.0, 1.0, 0.5), 3),
+            BvhNode::interior(c, 5),
+            BvhNode::interior(c, 7),
+            BvhNode::leaf(leaf, 4, 8),
+            BvhNode::leaf(leaf, 12, 8),
+            BvhNode::leaf(leaf, 20, 8),
+            BvhNode::leaf(leaf, 28, 8),
+        ];
+        assert_eq!(c.half_area(), 1.5);
+        let plan = plan::<4>(&bin, &counts(&bin));
+        assert_eq!(plan.iter().map(|p| p.cost).collect::<Vec<_>>(), [13.5, 1.0, 10.0, 5.5, 5.5, 2.0, 2.0, 2.0, 2.0]);
+        assert_eq!(plan[0].wide, 1, "A takes one of R's slots, B three");
+        assert_eq!(plan[2].split[2], 1, "B over three slots: C1 whole, C2 over two");
+        assert_eq!(plan[2].split[1], 0, "B over two slots stays whole");
+        assert_eq!(plan[4].split[1], 1);
     }
 }
