@@ -9,6 +9,7 @@
 use raylab_accel::bvh::{self, lbvh, Bvh, BvhNode, SplitMethod};
 use raylab_accel::{Accel, BuildOptions, Counters, PrimHit, Primitives};
 use raylab_core::{Aabb, Ray, Vec3};
+use raylab_testkit::bvh_shape as shape;
 
 /// Axis-aligned boxes as primitives (a hit is the entry into the box).
 struct Boxes(Vec<Aabb>);
@@ -33,24 +34,6 @@ fn aabb(min: [f32; 3], max: [f32; 3]) -> Aabb {
 /// A box of half size `h` centred at `(x, 0, 0)`.
 fn cube_at(x: f32, h: f32) -> Aabb {
     aabb([x - h, -h, -h], [x + h, h, h])
-}
-
-/// The tree as nested primitive sets, independent of the node layout: a leaf is its
-/// primitives in brackets (sorted), or the bare index for one; an interior node
-/// `(left right)`.
-fn shape(b: &Bvh) -> String {
-    fn walk(b: &Bvh, i: usize) -> String {
-        let n = &b.nodes[i];
-        if n.is_leaf() {
-            let mut p: Vec<u32> = b.indices[n.left_first as usize..(n.left_first + n.count) as usize].to_vec();
-            p.sort();
-            let s: Vec<String> = p.iter().map(u32::to_string).collect();
-            return if s.len() == 1 { s[0].clone() } else { format!("[{}]", s.join(" ")) };
-        }
-        let l = n.left_first as usize;
-        format!("({} {})", walk(b, l), walk(b, l + 1))
-    }
-    if b.nodes.is_empty() { String::new() } else { walk(b, 0) }
 }
 
 fn opts(traversal: f32, intersection: f32, max_leaf: usize, bins: usize) -> BuildOptions {

@@ -9,6 +9,7 @@
 use raylab_accel::bvh::{sbvh, Bvh};
 use raylab_accel::{BuildOptions, PrimHit, Primitives};
 use raylab_core::{Aabb, Ray, Vec3};
+use raylab_testkit::bvh_shape as shape;
 
 /// Axis-aligned boxes as primitives; clipping is the default `bounds ∩ clip`.
 struct Boxes(Vec<Aabb>);
@@ -69,23 +70,6 @@ fn rect(x0: f32, x1: f32, y0: f32, y1: f32) -> Aabb {
 
 fn opts(traversal: f32, intersection: f32, max_leaf: usize, bins: usize, alpha: f32) -> BuildOptions {
     BuildOptions { traversal_cost: traversal, intersection_cost: intersection, max_leaf_size: max_leaf, bins, spatial_split_alpha: alpha, ..BuildOptions::default() }
-}
-
-/// The tree as nested primitive sets: a leaf is its primitives in brackets (sorted), or the
-/// bare index for one; an interior node `(left right)`.
-fn shape(b: &Bvh) -> String {
-    fn walk(b: &Bvh, i: usize) -> String {
-        let n = &b.nodes[i];
-        if n.is_leaf() {
-            let mut p: Vec<u32> = b.indices[n.left_first as usize..(n.left_first + n.count) as usize].to_vec();
-            p.sort();
-            let s: Vec<String> = p.iter().map(u32::to_string).collect();
-            return if s.len() == 1 { s[0].clone() } else { format!("[{}]", s.join(" ")) };
-        }
-        let l = n.left_first as usize;
-        format!("({} {})", walk(b, l), walk(b, l + 1))
-    }
-    if b.nodes.is_empty() { String::new() } else { walk(b, 0) }
 }
 
 /// The leaves' boxes in depth-first order, left before right.

@@ -250,3 +250,21 @@ pub fn agrees_with_oracle<P: Primitives + ?Sized>(prims: &P, ray: &Ray, want: Op
         (w, g) => Err(format!("{g:?} vs oracle {w:?}")),
     }
 }
+
+/// A binary BVH as nested primitive sets, independent of the node layout: a leaf is its
+/// primitives in brackets (sorted), or the bare index for one; an interior node
+/// `(left right)`. Tests compare the trees builders make with trees worked out by hand.
+pub fn bvh_shape(b: &raylab_accel::Bvh) -> String {
+    fn walk(b: &raylab_accel::Bvh, i: usize) -> String {
+        let n = &b.nodes[i];
+        if n.is_leaf() {
+            let mut p: Vec<u32> = b.indices[n.left_first as usize..(n.left_first + n.count) as usize].to_vec();
+            p.sort();
+            let s: Vec<String> = p.iter().map(u32::to_string).collect();
+            return if s.len() == 1 { s[0].clone() } else { format!("[{}]", s.join(" ")) };
+        }
+        let l = n.left_first as usize;
+        format!("({} {})", walk(b, l), walk(b, l + 1))
+    }
+    if b.nodes.is_empty() { String::new() } else { walk(b, 0) }
+}
