@@ -7,25 +7,9 @@
 //! check that trees work and are good, not which tree a builder makes.)
 
 use raylab_accel::bvh::{self, lbvh, Bvh, BvhNode, SplitMethod};
-use raylab_accel::{Accel, BuildOptions, Counters, PrimHit, Primitives};
+use raylab_accel::{Accel, BuildOptions, Counters};
 use raylab_core::{Aabb, Ray, Vec3};
-use raylab_testkit::bvh_shape as shape;
-
-/// Axis-aligned boxes as primitives (a hit is the entry into the box).
-struct Boxes(Vec<Aabb>);
-
-impl Primitives for Boxes {
-    fn len(&self) -> usize {
-        self.0.len()
-    }
-    fn bounds(&self, i: u32) -> Aabb {
-        self.0[i as usize]
-    }
-    fn intersect(&self, i: u32, ray: &Ray) -> Option<PrimHit> {
-        let (t0, _) = self.0[i as usize].intersect_ray(ray)?;
-        (t0 > ray.t_min && t0 <= ray.t_max).then_some(PrimHit { t: t0, u: 0.0, v: 0.0 })
-    }
-}
+use raylab_testkit::{bvh_shape as shape, Boxes};
 
 fn aabb(min: [f32; 3], max: [f32; 3]) -> Aabb {
     Aabb::new(Vec3::from_array(min), Vec3::from_array(max))

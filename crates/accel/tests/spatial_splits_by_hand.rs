@@ -9,23 +9,7 @@
 use raylab_accel::bvh::{sbvh, Bvh};
 use raylab_accel::{BuildOptions, PrimHit, Primitives};
 use raylab_core::{Aabb, Ray, Vec3};
-use raylab_testkit::bvh_shape as shape;
-
-/// Axis-aligned boxes as primitives; clipping is the default `bounds ∩ clip`.
-struct Boxes(Vec<Aabb>);
-
-impl Primitives for Boxes {
-    fn len(&self) -> usize {
-        self.0.len()
-    }
-    fn bounds(&self, i: u32) -> Aabb {
-        self.0[i as usize]
-    }
-    fn intersect(&self, i: u32, ray: &Ray) -> Option<PrimHit> {
-        let (t0, _) = self.0[i as usize].intersect_ray(ray)?;
-        (t0 > ray.t_min && t0 <= ray.t_max).then_some(PrimHit { t: t0, u: 0.0, v: 0.0 })
-    }
-}
+use raylab_testkit::{bvh_shape as shape, Boxes};
 
 /// Line segments, clipped exactly (Liang–Barsky): the part of a diagonal segment inside a
 /// slab has a smaller box than the segment's box cut by the slab.

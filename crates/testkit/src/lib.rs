@@ -268,3 +268,20 @@ pub fn bvh_shape(b: &raylab_accel::Bvh) -> String {
     }
     if b.nodes.is_empty() { String::new() } else { walk(b, 0) }
 }
+
+/// Axis-aligned boxes as primitives: a hit is the entry into the box; clipping is the default
+/// `bounds ∩ clip`. Builder tests place them by hand.
+pub struct Boxes(pub Vec<Aabb>);
+
+impl Primitives for Boxes {
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+    fn bounds(&self, i: u32) -> Aabb {
+        self.0[i as usize]
+    }
+    fn intersect(&self, i: u32, ray: &Ray) -> Option<PrimHit> {
+        let (t0, _) = self.0[i as usize].intersect_ray(ray)?;
+        (t0 > ray.t_min && t0 <= ray.t_max).then_some(PrimHit { t: t0, u: 0.0, v: 0.0 })
+    }
+}
