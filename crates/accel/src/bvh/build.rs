@@ -1,8 +1,14 @@
 //! Top-down builders. Subtrees are built in parallel (`rayon::join`) into a temporary
 //! tree, which is then flattened depth-first with siblings adjacent.
+//!
+//! Primitives travel as [`PrimRef`]s, box and index together (Embree's layout), which the
+//! splits partition in place: binning and partitioning stream through memory instead of
+//! following an index into separate box and centroid arrays, and a partition hands each
+//! side its box and its centroids' box, so no node reads its primitives again to bound them.
 
+use glam::Vec3A;
 use rayon::prelude::*;
-use raylab_core::{Aabb, Vec3};
+use raylab_core::Aabb;
 
 use super::{BvhNode, SahCost, SplitMethod, MAX_DEPTH};
 use crate::{BuildOptions, Primitives};
@@ -10,34 +16,130 @@ use crate::{BuildOptions, Primitives};
 /// Subtrees smaller than this are built on the current thread.
 const PARALLEL_THRESHOLD: usize = 4096;
 
+/// Nodes with at least this many primitives are bounded and binned in parallel (the top
+/// levels of the tree, where `rayon::join` over subtrees has not yet spread the work).
+const PARALLEL_BINNING: usize = 1 << 15;
+const BIN_CHUNK: usize = 1 << 13;
+
 enum BuildNode {
     Leaf { bounds: Aabb, first: u32, count: u32 },
     Interior { bounds: Aabb, children: Box<[BuildNode; 2]> },
 }
 
-struct Ctx<'a> {
-    bounds: &'a [Aabb],
-    centroids: &'a [Vec3],
+/// A primitive's box and its index in the input.
+#[derive(Clone, Copy)]
+struct PrimRef {
+    min: Vec3A,
+    max: Vec3A,
+    id: u32,
+}
+
+impl PrimRef {
+    /// The same arithmetic as [`Aabb::centroid`], lane by lane.
+    #[inline]
+    fn centroid(&self) -> Vec3A {
+        0.5 * (self.min + self.max)
+    }
+}
+
+/// A box held in SIMD registers while building ([`Aabb`] keeps 12-byte `Vec3`s).
+#[derive(Clone, Copy)]
+struct Box3 {
+    min: Vec3A,
+    max: Vec3A,
+}
+
+impl Box3 {
+    const EMPTY: Box3 = Box3 { min: Vec3A::splat(f32::INFINITY), max: Vec3A::splat(f32::NEG_INFINITY) };
+
+    #[inline]
+    fn grow(&mut self, min: Vec3A, max: Vec3A) {
+        self.min = self.min.min(min);
+        self.max = self.max.max(max);
+    }
+
+    #[inline]
+    fn union(self, o: Box3) -> Box3 {
+        Box3 { min: self.min.min(o.min), max: self.max.max(o.max) }
+    }
+
+    /// [`Aabb::half_area`]'s formula, in the same order.
+    #[inline]
+    fn half_area(&self) -> f32 {
+        let d = (self.max - self.min).max(Vec3A::ZERO);
+        d.x * d.y + d.y * d.z + d.z * d.x
+    }
+
+    fn aabb(&self) -> Aabb {
+        Aabb { min: self.min.into(), max: self.max.into() }
+    }
+}
+
+/// What a node needs to know of its primitives: their box and their centroids' box.
+#[derive(Clone, Copy)]
+struct Extent {
+    geom: Box3,
+    cent: Box3,
+}
+
+impl Extent {
+    const EMPTY: Extent = Extent { geom: Box3::EMPTY, cent: Box3::EMPTY };
+
+    #[inline]
+    fn add(&mut self, r: &PrimRef) {
+        self.geom.grow(r.min, r.max);
+        let c = r.centroid();
+        self.cent.grow(c, c);
+    }
+
+    fn merge(self, o: Extent) -> Extent {
+        Extent { geom: self.geom.union(o.geom), cent: self.cent.union(o.cent) }
+    }
+
+    /// Bounds `refs`, in parallel for large slices (unions are exact: the same boxes
+    /// whatever the split of the work).
+    fn of(refs: &[PrimRef]) -> Extent {
+        let serial = |part: &[PrimRef]| {
+            let mut e = Extent::EMPTY;
+            part.iter().for_each(|r| e.add(r));
+            e
+        };
+        if refs.len() < PARALLEL_BINNING {
+            return serial(refs);
+        }
+        refs.par_chunks(BIN_CHUNK).map(serial).reduce(|| Extent::EMPTY, Extent::merge)
+    }
+}
+
+struct Ctx {
     method: SplitMethod,
     sah: SahCost,
     max_leaf: usize,
     bins: usize,
 }
 
+/// A split: the size of the left part (now in front) and the extents of both parts.
+type Split = (usize, Extent, Extent);
+
 pub(super) fn build<P: Primitives + ?Sized>(prims: &P, method: SplitMethod, opts: &BuildOptions) -> (Vec<BvhNode>, Vec<u32>) {
     let n = prims.len();
     if n == 0 {
         return (Vec::new(), Vec::new());
     }
-    let bounds: Vec<Aabb> = (0..n as u32).into_par_iter().map(|i| prims.bounds(i)).collect();
-    let centroids: Vec<Vec3> = bounds.par_iter().map(|b| b.centroid()).collect();
-    let mut indices: Vec<u32> = (0..n as u32).collect();
-    let ctx = Ctx { bounds: &bounds, centroids: &centroids, method, sah: SahCost::from_options(opts), max_leaf: opts.max_leaf_size.max(1), bins: opts.bins.clamp(2, 256) };
-    let root = ctx.build(&mut indices, 0, 1);
+    let mut refs: Vec<PrimRef> = (0..n as u32)
+        .into_par_iter()
+        .map(|i| {
+            let b = prims.bounds(i);
+            PrimRef { min: b.min.into(), max: b.max.into(), id: i }
+        })
+        .collect();
+    let ctx = Ctx { method, sah: SahCost::from_options(opts), max_leaf: opts.max_leaf_size.max(1), bins: opts.bins.clamp(2, 256) };
+    let extent = Extent::of(&refs);
+    let root = ctx.build(&mut refs, extent, 0, 1, &mut Scratch::new(ctx.bins));
     let mut nodes = Vec::with_capacity(2 * n);
     nodes.push(BvhNode::interior(Aabb::EMPTY, 0));
     flatten(root, 0, &mut nodes);
-    (nodes, indices)
+    (nodes, refs.iter().map(|r| r.id).collect())
 }
 
 fn flatten(node: BuildNode, slot: usize, nodes: &mut Vec<BvhNode>) {
@@ -55,78 +157,97 @@ fn flatten(node: BuildNode, slot: usize, nodes: &mut Vec<BvhNode>) {
     }
 }
 
-impl Ctx<'_> {
-    /// Builds the subtree over `idx`, whose first element sits at `offset` in the index array.
-    fn build(&self, idx: &mut [u32], offset: usize, depth: usize) -> BuildNode {
-        let bounds = self.union_of(idx, |i| self.bounds[i as usize]);
-        let leaf = BuildNode::Leaf { bounds, first: offset as u32, count: idx.len() as u32 };
-        if idx.len() <= 1 || depth >= MAX_DEPTH {
+/// Per-thread working memory of the binned SAH, allocated once per subtree built on a
+/// thread of its own rather than once per node.
+struct Scratch {
+    bins: Bins,
+    right_area: Vec<f32>,
+    right_count: Vec<usize>,
+}
+
+impl Scratch {
+    fn new(nb: usize) -> Self {
+        Self { bins: Bins::new(nb), right_area: vec![0.0; nb], right_count: vec![0; nb] }
+    }
+}
+
+impl Ctx {
+    /// Builds the subtree over `refs` (bounded by `extent`), whose first element sits at
+    /// `offset` in the final primitive order.
+    fn build(&self, refs: &mut [PrimRef], extent: Extent, offset: usize, depth: usize, scratch: &mut Scratch) -> BuildNode {
+        let bounds = extent.geom.aabb();
+        let leaf = BuildNode::Leaf { bounds, first: offset as u32, count: refs.len() as u32 };
+        if refs.len() <= 1 || depth >= MAX_DEPTH {
             return leaf;
         }
-        let Some(mid) = self.split(idx, &bounds) else { return leaf };
-        let (l, r) = idx.split_at_mut(mid);
+        let Some((mid, le, re)) = self.split(refs, &extent, scratch) else { return leaf };
+        let (l, r) = refs.split_at_mut(mid);
         let (left, right) = if l.len() + r.len() >= PARALLEL_THRESHOLD {
-            rayon::join(|| self.build(l, offset, depth + 1), || self.build(r, offset + mid, depth + 1))
+            rayon::join(|| self.build(l, le, offset, depth + 1, scratch), || self.build(r, re, offset + mid, depth + 1, &mut Scratch::new(self.bins)))
         } else {
-            (self.build(l, offset, depth + 1), self.build(r, offset + mid, depth + 1))
+            (self.build(l, le, offset, depth + 1, scratch), self.build(r, re, offset + mid, depth + 1, scratch))
         };
         BuildNode::Interior { bounds, children: Box::new([left, right]) }
     }
 
-    /// Partitions `idx` and returns the size of the left part, or `None` for a leaf.
-    fn split(&self, idx: &mut [u32], bounds: &Aabb) -> Option<usize> {
-        let cb = self.union_of(idx, |i| Aabb::new(self.centroids[i as usize], self.centroids[i as usize]));
+    /// Partitions `refs`, or `None` for a leaf.
+    fn split(&self, refs: &mut [PrimRef], extent: &Extent, scratch: &mut Scratch) -> Option<Split> {
+        let cb = extent.cent.aabb();
         let axis = cb.max_axis();
-        let extent = cb.max[axis] - cb.min[axis];
-        if extent <= 0.0 {
+        if cb.max[axis] - cb.min[axis] <= 0.0 {
             // All centroids coincide: no plane separates them. Split by index only when the
             // leaf would be too large, so leaves stay bounded.
-            return (idx.len() > self.max_leaf).then_some(idx.len() / 2);
+            return (refs.len() > self.max_leaf).then(|| halves(refs, refs.len() / 2));
         }
         match self.method {
-            SplitMethod::BinnedSah => self.split_sah(idx, bounds, &cb),
-            SplitMethod::Median => (idx.len() > self.max_leaf).then(|| self.split_median(idx, axis)),
+            SplitMethod::BinnedSah => self.split_sah(refs, extent, scratch),
+            SplitMethod::Median => (refs.len() > self.max_leaf).then(|| split_median(refs, axis)),
             SplitMethod::Midpoint => {
-                if idx.len() <= self.max_leaf {
+                if refs.len() <= self.max_leaf {
                     return None;
                 }
                 let mid = 0.5 * (cb.min[axis] + cb.max[axis]);
-                let m = partition(idx, |i| self.centroids[i as usize][axis] < mid);
-                Some(if m == 0 || m == idx.len() { self.split_median(idx, axis) } else { m })
+                let split = partition(refs, |r| r.centroid()[axis] < mid);
+                Some(if split.0 == 0 || split.0 == refs.len() { split_median(refs, axis) } else { split })
             }
         }
-    }
-
-    fn split_median(&self, idx: &mut [u32], axis: usize) -> usize {
-        let mid = idx.len() / 2;
-        idx.select_nth_unstable_by(mid, |&a, &b| self.centroids[a as usize][axis].total_cmp(&self.centroids[b as usize][axis]));
-        mid
     }
 
     /// Binned SAH over all three axes (Wald 2007, "On fast Construction of SAH-based
     /// Bounding Volume Hierarchies"): centroids fall into `bins` equal bins per axis; the
     /// `bins - 1` planes between bins are evaluated by a prefix/suffix sweep.
-    fn split_sah(&self, idx: &mut [u32], bounds: &Aabb, cb: &Aabb) -> Option<usize> {
+    fn split_sah(&self, refs: &mut [PrimRef], extent: &Extent, scratch: &mut Scratch) -> Option<Split> {
         let nb = self.bins;
+        let cb = &extent.cent;
+        let scale = Vec3A::select((cb.max - cb.min).cmpgt(Vec3A::ZERO), Vec3A::splat(nb as f32) / (cb.max - cb.min), Vec3A::ZERO);
+        let bins = &mut scratch.bins;
+        bins.clear();
+        if refs.len() < PARALLEL_BINNING {
+            bins.add(refs, cb.min, scale);
+        } else {
+            let parts = refs.par_chunks(BIN_CHUNK).map(|part| {
+                let mut b = Bins::new(nb);
+                b.add(part, cb.min, scale);
+                b
+            });
+            *bins = parts.reduce(|| Bins::new(nb), Bins::merge);
+        }
+        let (right_area, right_count) = (&mut scratch.right_area, &mut scratch.right_count);
+        let pa = extent.geom.half_area();
         let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, plane)
-        let mut right_area = vec![0.0f32; nb];
-        let mut right_count = vec![0usize; nb];
-        let bins = self.bin(idx, cb);
         for axis in 0..3 {
-            let (lo, hi) = (cb.min[axis], cb.max[axis]);
-            if hi <= lo {
+            if scale[axis] == 0.0 {
                 continue;
             }
             let (bin_bounds, bin_count) = (&bins.bounds[axis * nb..(axis + 1) * nb], &bins.count[axis * nb..(axis + 1) * nb]);
-            let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+            let (mut acc, mut cnt) = (Box3::EMPTY, 0);
             for p in (1..nb).rev() {
                 acc = acc.union(bin_bounds[p]);
                 cnt += bin_count[p];
                 right_area[p] = acc.half_area();
                 right_count[p] = cnt;
             }
-            let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
-            let pa = bounds.half_area();
+            let (mut acc, mut cnt) = (Box3::EMPTY, 0);
             for p in 1..nb {
                 acc = acc.union(bin_bounds[p - 1]);
                 cnt += bin_count[p - 1];
@@ -136,7 +257,7 @@ impl Ctx<'_> {
                 let cost = if pa > 0.0 {
                     self.sah.traversal + self.sah.intersection * (acc.half_area() * cnt as f32 + right_area[p] * right_count[p] as f32) / pa
                 } else {
-                    self.sah.traversal + self.sah.intersection * idx.len() as f32
+                    self.sah.traversal + self.sah.intersection * refs.len() as f32
                 };
                 if best.is_none_or(|(c, _, _)| cost < c) {
                     best = Some((cost, axis, p));
@@ -144,27 +265,60 @@ impl Ctx<'_> {
             }
         }
         let (cost, axis, plane) = best?;
-        if cost >= self.sah.leaf(idx.len()) && idx.len() <= self.max_leaf {
+        if cost >= self.sah.leaf(refs.len()) && refs.len() <= self.max_leaf {
             return None;
         }
-        let (lo, hi) = (cb.min[axis], cb.max[axis]);
-        let scale = nb as f32 / (hi - lo);
-        let m = partition(idx, |i| bin_of(self.centroids[i as usize][axis], lo, scale, nb) < plane);
-        debug_assert!(m > 0 && m < idx.len());
-        Some(m)
+        let (lo, s) = (cb.min[axis], scale[axis]);
+        let split = partition(refs, |r| bin_of(r.centroid()[axis], lo, s, nb) < plane);
+        debug_assert!(split.0 > 0 && split.0 < refs.len());
+        Some(split)
     }
+}
+
+/// Splits at the object median along `axis` (ties in any order).
+fn split_median(refs: &mut [PrimRef], axis: usize) -> Split {
+    let mid = refs.len() / 2;
+    refs.select_nth_unstable_by(mid, |a, b| a.centroid()[axis].total_cmp(&b.centroid()[axis]));
+    halves(refs, mid)
+}
+
+/// Splits at `mid` as the primitives lie.
+fn halves(refs: &[PrimRef], mid: usize) -> Split {
+    (mid, Extent::of(&refs[..mid]), Extent::of(&refs[mid..]))
 }
 
 /// Bins of the three axes, `nb` per axis (axis-major): the union of the boxes whose
 /// centroid falls in each bin, and their count.
 struct Bins {
-    bounds: Vec<Aabb>,
+    bounds: Vec<Box3>,
     count: Vec<usize>,
 }
 
 impl Bins {
     fn new(nb: usize) -> Self {
-        Self { bounds: vec![Aabb::EMPTY; 3 * nb], count: vec![0; 3 * nb] }
+        Self { bounds: vec![Box3::EMPTY; 3 * nb], count: vec![0; 3 * nb] }
+    }
+
+    fn clear(&mut self) {
+        self.bounds.fill(Box3::EMPTY);
+        self.count.fill(0);
+    }
+
+    /// Bins `refs` along the three axes of the centroid box starting at `lo` with `scale`
+    /// bins per unit (0 on axes of zero extent, whose bins are then never read). Unions and
+    /// counts are exact, so splitting the work over threads gives the same bins, hence the
+    /// same tree, whatever the thread count.
+    #[inline]
+    fn add(&mut self, refs: &[PrimRef], lo: Vec3A, scale: Vec3A) {
+        let nb = self.count.len() / 3;
+        for r in refs {
+            let t = ((r.centroid() - lo) * scale).to_array();
+            for (axis, t) in t.into_iter().enumerate() {
+                let k = axis * nb + (t as usize).min(nb - 1);
+                self.bounds[k].grow(r.min, r.max);
+                self.count[k] += 1;
+            }
+        }
     }
 
     fn merge(mut self, o: Bins) -> Bins {
@@ -178,62 +332,25 @@ impl Bins {
     }
 }
 
-/// Nodes with at least this many primitives are binned in parallel (the top levels of the
-/// tree, where `rayon::join` over subtrees has not yet spread the work).
-const PARALLEL_BINNING: usize = 1 << 15;
-const BIN_CHUNK: usize = 1 << 13;
-
-impl Ctx<'_> {
-    /// The union of `f(i)` over `idx`, in parallel for large nodes (unions are exact: the
-    /// same box whatever the split of the work).
-    fn union_of(&self, idx: &[u32], f: impl Fn(u32) -> Aabb + Sync) -> Aabb {
-        if idx.len() < PARALLEL_BINNING {
-            return idx.iter().fold(Aabb::EMPTY, |b, &i| b.union(f(i)));
-        }
-        idx.par_chunks(BIN_CHUNK).map(|part| part.iter().fold(Aabb::EMPTY, |b, &i| b.union(f(i)))).reduce(|| Aabb::EMPTY, Aabb::union)
-    }
-
-    /// Bins `idx` along the three axes of the centroid box `cb` (axes of zero extent get
-    /// empty bins). Unions and counts are exact, so splitting the work over threads gives
-    /// the same bins, hence the same tree, whatever the thread count.
-    fn bin(&self, idx: &[u32], cb: &Aabb) -> Bins {
-        let nb = self.bins;
-        let scale: [f32; 3] = std::array::from_fn(|a| if cb.max[a] > cb.min[a] { nb as f32 / (cb.max[a] - cb.min[a]) } else { 0.0 });
-        let bin_part = |part: &[u32]| {
-            let mut bins = Bins::new(nb);
-            for &i in part {
-                let c = self.centroids[i as usize];
-                let b = self.bounds[i as usize];
-                for axis in 0..3 {
-                    if scale[axis] > 0.0 {
-                        let k = axis * nb + bin_of(c[axis], cb.min[axis], scale[axis], nb);
-                        bins.bounds[k] = bins.bounds[k].union(b);
-                        bins.count[k] += 1;
-                    }
-                }
-            }
-            bins
-        };
-        if idx.len() < PARALLEL_BINNING {
-            return bin_part(idx);
-        }
-        idx.par_chunks(BIN_CHUNK).map(bin_part).reduce(|| Bins::new(nb), Bins::merge)
-    }
-}
-
 #[inline]
 fn bin_of(c: f32, lo: f32, scale: f32, nb: usize) -> usize {
     (((c - lo) * scale) as usize).min(nb - 1)
 }
 
-/// In-place partition; returns the number of elements for which `pred` holds (now in front).
-fn partition(idx: &mut [u32], pred: impl Fn(u32) -> bool) -> usize {
+/// In-place partition: the primitives for which `left` holds move to the front, in the
+/// order of a single forward sweep of swaps; returns their number and both sides' extents.
+fn partition(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool) -> Split {
+    let (mut le, mut re) = (Extent::EMPTY, Extent::EMPTY);
     let mut m = 0;
-    for k in 0..idx.len() {
-        if pred(idx[k]) {
-            idx.swap(k, m);
+    for k in 0..refs.len() {
+        let r = refs[k];
+        if left(&r) {
+            le.add(&r);
+            refs.swap(k, m);
             m += 1;
+        } else {
+            re.add(&r);
         }
     }
-    m
+    (m, le, re)
 }
