@@ -217,17 +217,19 @@ impl Ctx {
     /// Bounding Volume Hierarchies"): centroids fall into `bins` equal bins per axis; the
     /// `bins - 1` planes between bins are evaluated by a prefix/suffix sweep.
     fn split_sah(&self, refs: &mut [PrimRef], extent: &Extent, scratch: &mut Scratch) -> Option<Split> {
-        let nb = self.bins;
+        // Fewer bins for small nodes, as Embree does (4 + n/20, at most `bins`): most nodes
+        // are small, and there clearing and sweeping the bins cost more than binning.
+        let nb = self.bins.min(4 + refs.len() / 20);
         let cb = &extent.cent;
         let scale = Vec3A::select((cb.max - cb.min).cmpgt(Vec3A::ZERO), Vec3A::splat(nb as f32) / (cb.max - cb.min), Vec3A::ZERO);
         let bins = &mut scratch.bins;
-        bins.clear();
+        bins.clear(nb);
         if refs.len() < PARALLEL_BINNING {
-            bins.add(refs, cb.min, scale);
+            bins.add(refs, nb, cb.min, scale);
         } else {
             let parts = refs.par_chunks(BIN_CHUNK).map(|part| {
                 let mut b = Bins::new(nb);
-                b.add(part, cb.min, scale);
+                b.add(part, nb, cb.min, scale);
                 b
             });
             *bins = parts.reduce(|| Bins::new(nb), Bins::merge);
@@ -287,7 +289,7 @@ fn halves(refs: &[PrimRef], mid: usize) -> Split {
     (mid, Extent::of(&refs[..mid]), Extent::of(&refs[mid..]))
 }
 
-/// Bins of the three axes, `nb` per axis (axis-major): the union of the boxes whose
+/// Bins of the three axes, `nb` per axis (axis-major, in the first `3 nb` entries): the union of the boxes whose
 /// centroid falls in each bin, and their count.
 struct Bins {
     bounds: Vec<Box3>,
@@ -299,9 +301,10 @@ impl Bins {
         Self { bounds: vec![Box3::EMPTY; 3 * nb], count: vec![0; 3 * nb] }
     }
 
-    fn clear(&mut self) {
-        self.bounds.fill(Box3::EMPTY);
-        self.count.fill(0);
+    /// Empties the first `nb` bins of each axis.
+    fn clear(&mut self, nb: usize) {
+        self.bounds[..3 * nb].fill(Box3::EMPTY);
+        self.count[..3 * nb].fill(0);
     }
 
     /// Bins `refs` along the three axes of the centroid box starting at `lo` with `scale`
@@ -309,12 +312,13 @@ impl Bins {
     /// counts are exact, so splitting the work over threads gives the same bins, hence the
     /// same tree, whatever the thread count.
     #[inline]
-    fn add(&mut self, refs: &[PrimRef], lo: Vec3A, scale: Vec3A) {
-        let nb = self.count.len() / 3;
+    fn add(&mut self, refs: &[PrimRef], nb: usize, lo: Vec3A, scale: Vec3A) {
+        let top = Vec3A::splat((nb - 1) as f32);
         for r in refs {
-            let t = ((r.centroid() - lo) * scale).to_array();
+            let t = ((r.centroid() - lo) * scale).max(Vec3A::ZERO).min(top).to_array();
             for (axis, t) in t.into_iter().enumerate() {
-                let k = axis * nb + (t as usize).min(nb - 1);
+                // SAFETY: `t` is in [0, nb - 1] (a NaN became 0 at `max`), so it converts.
+                let k = axis * nb + unsafe { t.to_int_unchecked::<u32>() } as usize;
                 self.bounds[k].grow(r.min, r.max);
                 self.count[k] += 1;
             }
@@ -332,9 +336,10 @@ impl Bins {
     }
 }
 
+/// The bin of centroid coordinate `c`, as [`Bins::add`] computes it.
 #[inline]
 fn bin_of(c: f32, lo: f32, scale: f32, nb: usize) -> usize {
-    (((c - lo) * scale) as usize).min(nb - 1)
+    ((c - lo) * scale).max(0.0).min((nb - 1) as f32) as usize
 }
 
 /// In-place partition: the primitives for which `left` holds move to the front, in the
