@@ -236,7 +236,8 @@ impl Ctx {
         }
         let (right_area, right_count) = (&mut scratch.right_area, &mut scratch.right_count);
         let pa = extent.geom.half_area();
-        let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, plane)
+        // The cheapest plane so far: (cost, axis, plane); `axis == 3` while there is none.
+        let (mut best_cost, mut best_axis, mut best_plane) = (f32::INFINITY, 3, 0);
         for axis in 0..3 {
             if scale[axis] == 0.0 {
                 continue;
@@ -261,17 +262,19 @@ impl Ctx {
                 } else {
                     self.sah.traversal + self.sah.intersection * refs.len() as f32
                 };
-                if best.is_none_or(|(c, _, _)| cost < c) {
-                    best = Some((cost, axis, p));
+                if best_axis == 3 || cost < best_cost {
+                    (best_cost, best_axis, best_plane) = (cost, axis, p);
                 }
             }
         }
-        let (cost, axis, plane) = best?;
-        if cost >= self.sah.leaf(refs.len()) && refs.len() <= self.max_leaf {
+        let (axis, plane) = (best_axis, best_plane);
+        if axis == 3 || (best_cost >= self.sah.leaf(refs.len()) && refs.len() <= self.max_leaf) {
             return None;
         }
-        let (lo, s) = (cb.min[axis], scale[axis]);
-        let split = partition(refs, |r| bin_of(r.centroid()[axis], lo, s, nb) < plane);
+        // Bin `⌊clamp((c - lo) · s, 0, nb - 1)⌋ < plane` as one comparison: the plane is a
+        // whole number at most `nb - 1`, and a NaN falls in bin 0, on the left.
+        let (lo, s, plane_f) = (cb.min[axis], scale[axis], plane as f32);
+        let split = partition(refs, |r| !((r.centroid()[axis] - lo) * s >= plane_f));
         debug_assert!(split.0 > 0 && split.0 < refs.len());
         Some(split)
     }
@@ -334,12 +337,6 @@ impl Bins {
         }
         self
     }
-}
-
-/// The bin of centroid coordinate `c`, as [`Bins::add`] computes it.
-#[inline]
-fn bin_of(c: f32, lo: f32, scale: f32, nb: usize) -> usize {
-    ((c - lo) * scale).max(0.0).min((nb - 1) as f32) as usize
 }
 
 /// In-place partition: the primitives for which `left` holds move to the front, in the

@@ -9,7 +9,8 @@
 //! Subtrees of at most [`LEAF_PRIMS`] references may become leaves (two blocks); binary
 //! leaves always do.
 
-use raylab_core::Aabb;
+use rayon::prelude::*;
+use raylab_core::{Aabb, Vec3};
 
 use super::node::{leaf_ref, ChildRef, TriBlock, WideNode, MAX_BLOCKS, MAX_LEAF_BLOCKS};
 use crate::bvh::{Bvh, BvhNode};
@@ -29,6 +30,9 @@ struct Ctx<'a, P: ?Sized, const W: usize> {
     bin: &'a [BvhNode],
     indices: &'a [u32],
     prims: &'a P,
+    /// Each primitive's vertices (`None`: not a triangle), read in the mesh's order once:
+    /// leaves then fetch one record per triangle instead of four dependent loads.
+    triangles: Vec<Option<[Vec3; 3]>>,
     /// References below each binary node.
     counts: Vec<usize>,
     /// The dynamic programme's choices per binary node (see [`plan`]).
@@ -51,7 +55,8 @@ pub(super) fn collapse<P: Primitives + ?Sized, const W: usize>(bvh: &Bvh, prims:
         counts[i] = if n.is_leaf() { n.count as usize } else { counts[n.left_first as usize] + counts[n.left_first as usize + 1] };
     }
     let plan = plan::<W>(bin, &counts);
-    let mut ctx = Ctx { bin, indices: &bvh.indices, prims, counts, plan, nodes: Vec::with_capacity(bin.len() / W + 1), blocks: Vec::with_capacity(prims.len() / 2 + 1) };
+    let triangles = (0..prims.len() as u32).into_par_iter().map(|p| prims.triangle(p)).collect();
+    let mut ctx = Ctx { bin, indices: &bvh.indices, prims, triangles, counts, plan, nodes: Vec::with_capacity(bin.len() / W + 1), blocks: Vec::with_capacity(prims.len() / 2 + 1) };
     let root = ctx.child(0);
     assert!(ctx.blocks.len() <= MAX_BLOCKS, "wide BVH: too many triangle blocks");
     Collapsed { nodes: ctx.nodes, blocks: ctx.blocks, root, root_bounds: bin[0].bounds() }
@@ -176,7 +181,7 @@ impl<P: Primitives + ?Sized, const W: usize> Ctx<'_, P, W> {
             for chunk in refs.chunks(4) {
                 let mut b = TriBlock::EMPTY_BLOCK;
                 for (lane, &p) in chunk.iter().enumerate() {
-                    match self.prims.triangle(p) {
+                    match self.triangles[p as usize] {
                         Some(v) => b.set_triangle(lane, p, v),
                         None => b.prim[lane] = p | TriBlock::OTHER,
                     }
