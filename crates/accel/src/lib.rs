@@ -179,7 +179,8 @@ pub struct BuildOptions {
     pub intersection_cost: f32,
     /// Leaves never hold more primitives than this unless they cannot be split.
     pub max_leaf_size: usize,
-    /// Number of bins of binned builders.
+    /// Bins per axis of binned builders; `bvh`'s binned SAH gives nodes of `n` primitives
+    /// `min(bins, 4 + n/20)` (Embree's rule: small nodes need fewer).
     pub bins: usize,
     /// Grid cells per primitive, `λ` (the grid has about `λ·N` cells). pbrt-v1's `3∛N`
     /// cells on the longest axis amounts to `λ = 27` on a cube; a handful is usual

@@ -68,7 +68,7 @@ pub struct SettingsArgs {
     /// Largest leaf of the acceleration structure's build (default 8)
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=255))]
     pub max_leaf_size: Option<u32>,
-    /// Bins of the binned SAH builders (default 16)
+    /// Bins per axis of the binned SAH builders (default 16; small nodes of the binned SAH use fewer: 4 + n/20)
     #[arg(long, value_parser = clap::value_parser!(u32).range(2..=1024))]
     pub bins: Option<u32>,
     /// Builder under bvh, bvh4 and bvh8, as Embree's quality: low (LBVH, fastest build), medium (binned SAH, the default), high (SBVH with spatial splits, best tree); see docs/performance.md
