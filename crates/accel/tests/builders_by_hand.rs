@@ -254,6 +254,23 @@ fn binned_sah_weighs_left_and_right_by_their_counts() {
 }
 
 #[test]
+fn binned_sah_bins_small_nodes_coarser() {
+    // Twenty cubes of half size 1/4 at x = 0, 1, ..., 19. A node of n primitives is binned
+    // into min(bins, 4 + n/20) bins (Embree's rule), so the root gets 5 bins of width 19/5:
+    // x 0-3, 4-7, 8-11, 12-15, 16-19. A left part of 4k cubes spans 4k - 1/2 in x, half area
+    // 4k - 1/4, so Σ half area × count is 15 + 252 = 267, 62 + 141 = 203, 203 and 267 for
+    // k = 1..4: the tie goes to the first plane, 8 cubes on the left (x up to 7.25).
+    // With 16 bins the even split 10 | 10 (195) would be reachable and chosen; with 4 (or
+    // 3) bins, 10 | 10 (or 7 | 13).
+    let s = Boxes((0..20).map(|i| cube_at(i as f32, 0.25)).collect());
+    let b = Bvh::build(&s, SplitMethod::BinnedSah, &opts(1.0, 1.0, 1, 16));
+    b.validate(&s).unwrap();
+    let l = b.nodes[0].left_first as usize;
+    assert_eq!(b.nodes[l].bounds(), aabb([-0.25; 3], [7.25, 0.25, 0.25]));
+    assert_eq!(b.nodes[l + 1].bounds(), aabb([7.75, -0.25, -0.25], [19.25, 0.25, 0.25]));
+}
+
+#[test]
 fn binned_sah_leaf_or_split_decision_follows_the_cost_formula() {
     // Two unit cubes with gap g (see `pair`): the only split, {A}|{B}, costs
     // T + I·(3 + 3)/(5 + 2g) against a leaf of I·2; a split happens when it is cheaper, or
