@@ -55,8 +55,10 @@ pub trait Primitives: Sync {
     }
 
     /// Bounds of the part of primitive `i` that lies inside `clip`, for spatial splits
-    /// (kd-tree "perfect splits", SBVH). The default, `bounds ∩ clip`, is conservative;
-    /// triangles override it with exact polygon clipping.
+    /// (kd-tree "perfect splits", SBVH, grid cells). The default, `bounds ∩ clip`, is
+    /// conservative; triangles should clip exactly (`raylab_core::clip::triangle_bounds`, as
+    /// the renderer's `Geometry` and the testkit's `Soup` do), which keeps a triangle out of
+    /// the cells and children that its box overlaps but it does not.
     fn clipped_bounds(&self, i: u32, clip: &Aabb) -> Aabb {
         self.bounds(i).intersection(*clip)
     }

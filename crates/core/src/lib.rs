@@ -3,6 +3,7 @@
 //! Nothing here knows about shapes, materials or files.
 
 pub mod bounds;
+pub mod clip;
 pub mod color;
 pub mod distribution;
 pub mod edges;

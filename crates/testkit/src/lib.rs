@@ -73,6 +73,13 @@ impl Primitives for Soup {
         }
     }
 
+    fn clipped_bounds(&self, i: u32, clip: &Aabb) -> Aabb {
+        match self.prims[i as usize] {
+            Prim::Triangle(v) => raylab_core::clip::triangle_bounds(v, clip),
+            Prim::Sphere { .. } => Primitives::bounds(self, i).intersection(*clip),
+        }
+    }
+
     fn objects(&self) -> Vec<Range<u32>> {
         self.objects.clone()
     }

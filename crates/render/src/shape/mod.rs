@@ -220,6 +220,14 @@ impl Primitives for Geometry {
         }
     }
 
+    /// Triangles clipped exactly (spatial splits); other shapes keep `bounds ∩ clip`.
+    fn clipped_bounds(&self, i: u32, clip: &Aabb) -> Aabb {
+        match self.prims[i as usize] {
+            PrimRef::Triangle { mesh, tri } => raylab_core::clip::triangle_bounds(self.meshes[mesh as usize].vertices(tri), clip),
+            PrimRef::Sphere(_) | PrimRef::Curve { .. } | PrimRef::Patch { .. } => self.bounds(i).intersection(*clip),
+        }
+    }
+
     /// Mesh triangles, whose `intersect` is `intersect::triangle` on these vertices.
     fn triangle(&self, i: u32) -> Option<[Vec3; 3]> {
         match self.prims[i as usize] {
