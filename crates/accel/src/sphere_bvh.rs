@@ -310,6 +310,13 @@ mod tests {
         // centre: 0.866022 (less by 3.9·10⁻⁶ of it) passes, 0.86601 (1.7·10⁻⁵) does not.
         check(leaf(13.5, 0.866022), vec![0, 1], 2).unwrap();
         assert_eq!(check(leaf(13.5, 0.86601), vec![0, 1], 2).unwrap_err(), "primitive 1 sticks out of leaf 2");
+        // Exactly at the slack: in f32, √0.75 rounds to 0x3F5DB3D7 and 1 + 10⁻⁵ to
+        // 1.0000100136 (0x3F800054); the radius 0x3F5DB346 ≈ 0.86601675 times that rounds to
+        // exactly 0x3F5DB3D7 (the product, exact in f64, is 0.8660254175, 2.9·10⁻⁸ from it and 3.0·10⁻⁸ from
+        // the next float up), so the corners lie on the bound: inside. One ulp less
+        // (0x3F5DB345) rounds below √0.75: outside.
+        check(leaf(13.5, f32::from_bits(0x3F5D_B346)), vec![0, 1], 2).unwrap();
+        assert_eq!(check(leaf(13.5, f32::from_bits(0x3F5D_B345)), vec![0, 1], 2).unwrap_err(), "primitive 1 sticks out of leaf 2");
         // Two interior nodes sharing children 3 and 4: node 4 is reached twice.
         let shared = vec![node(1, 0), node(3, 0), node(3, 0), node(0, 1), node(1, 1)];
         assert_eq!(check(shared, vec![0, 1], 2).unwrap_err(), "node 4 reached twice");
