@@ -427,4 +427,43 @@ mod tests {
         let e = "octree".parse::<AccelKind>().unwrap_err();
         assert_eq!(e.to_string(), format!("unknown acceleration structure `octree` (valid: {})", AccelKind::names()));
     }
+
+    /// The names, written out: the list the error message and `--help` show, and `Display`.
+    #[test]
+    fn names_by_hand() {
+        let all = "none, bvh, bvh-median, bvh-midpoint, aabb, grid, lbvh, lbvh-ploc, kdtree, sphere-bvh, sbvh, bvh8, bvh4, bvh8-sbvh, bvh8q";
+        assert_eq!(AccelKind::names(), all);
+        let shown: Vec<String> = AccelKind::ALL.iter().map(|k| k.to_string()).collect();
+        assert_eq!(shown.join(", "), all);
+        assert_eq!(format!("[{}]", AccelKind::Bvh8Q), "[bvh8q]");
+        assert_eq!("sphere-bvh".parse::<AccelKind>(), Ok(AccelKind::SphereBvh));
+        assert_eq!("Bvh".parse::<AccelKind>(), Err(UnknownAccel("Bvh".into())));
+    }
+
+    /// The margins by hand (issue 12), on scenes whose values are exact in `f32`:
+    /// - `[-1, 3]³`: extent 4, so the leaf margin is 4·2⁻¹⁸ = 2⁻¹⁶; the largest coordinate
+    ///   3 lies in [2, 4), where an ulp is 2¹⁻²³ = 2⁻²², four of them 2⁻²⁰;
+    /// - the same shape of size 20 shifted to 10⁶ (`[10⁶, 10⁶ + 20]`): leaf margin
+    ///   20·2⁻¹⁸ = 5·2⁻¹⁶; 10⁶ + 20 lies in [2¹⁹, 2²⁰), an ulp of 2¹⁹⁻²³ = 1/16, four 1/4;
+    /// - a point (extent 0): the leaf margin is the least normal number, not 0;
+    /// - the empty scene: the least normal number for both.
+    #[test]
+    fn margins_by_hand() {
+        let cube = Aabb::new(raylab_core::Vec3::splat(-1.0), raylab_core::Vec3::splat(3.0));
+        assert_eq!(leaf_margin(&cube), 2f32.powi(-16));
+        assert_eq!(robust_margin(&cube), 2f32.powi(-16) + 2f32.powi(-20));
+        let far = Aabb::new(raylab_core::Vec3::new(1e6, 1e6, 1e6 + 5.0), raylab_core::Vec3::new(1e6 + 20.0, 1e6 + 10.0, 1e6 + 10.0));
+        assert_eq!(leaf_margin(&far), 5.0 * 2f32.powi(-16));
+        assert_eq!(robust_margin(&far), 5.0 * 2f32.powi(-16) + 0.25);
+        // A negative coordinate counts by its magnitude: [-(10⁶ + 20), -10⁶] as above.
+        let negative = Aabb::new(-far.max, -far.min);
+        assert_eq!(robust_margin(&negative), 5.0 * 2f32.powi(-16) + 0.25);
+        let point = Aabb::new(raylab_core::Vec3::splat(1.0), raylab_core::Vec3::splat(1.0));
+        assert_eq!(leaf_margin(&point), f32::MIN_POSITIVE);
+        // 1 lies in [1, 2): an ulp of 2⁻²³, four of them 2⁻²¹ (the least normal number
+        // added to it is lost in rounding).
+        assert_eq!(robust_margin(&point), 2f32.powi(-21));
+        assert_eq!(leaf_margin(&Aabb::EMPTY), f32::MIN_POSITIVE);
+        assert_eq!(robust_margin(&Aabb::EMPTY), f32::MIN_POSITIVE);
+    }
 }

@@ -76,20 +76,20 @@ impl SphereBvh {
         Self { nodes, indices, primitives: n, build_ms: 0.0 }
     }
 
-    /// Visits every node with its depth (root depth 1). Only children stored after their
-    /// parent are followed, so that a broken tree whose children point back cannot make the
-    /// walk loop for ever (`validate` reports them).
-    fn visit(&self, mut f: impl FnMut(usize, usize)) {
+    /// Visits every node. Only children stored after their parent are followed, so that a
+    /// broken tree whose children point back cannot make the walk loop for ever (`validate`
+    /// reports them).
+    fn visit(&self, mut f: impl FnMut(usize)) {
         if self.nodes.is_empty() {
             return;
         }
-        let mut stack = vec![(0usize, 1usize)];
-        while let Some((i, depth)) = stack.pop() {
-            f(i, depth);
+        let mut stack = vec![0usize];
+        while let Some(i) = stack.pop() {
+            f(i);
             let n = &self.nodes[i];
             if !n.is_leaf() && (n.left_first as usize) > i && (n.left_first as usize) + 1 < self.nodes.len() {
-                stack.push((n.left_first as usize, depth + 1));
-                stack.push((n.left_first as usize + 1, depth + 1));
+                stack.push(n.left_first as usize);
+                stack.push(n.left_first as usize + 1);
             }
         }
     }
@@ -152,7 +152,7 @@ impl Accel for SphereBvh {
         let mut problem = None;
         let mut reached = vec![false; self.nodes.len()];
         let mut seen = vec![0u32; prims.len()];
-        self.visit(|i, _| {
+        self.visit(|i| {
             if problem.is_some() {
                 return;
             }
@@ -231,6 +231,37 @@ mod tests {
         SphereBvh { nodes, indices, primitives: n, build_ms: 0.0 }.validate(&Cubes(n)).map_err(|e| e.message)
     }
 
+    /// Two unit cubes at x = 10 and 13, built: the scene's extent is 4, so leaves grow by
+    /// 4·2⁻¹⁸ = 2⁻¹⁶ beyond the cubes' bounding spheres (centres (10.5, ½, ½) and
+    /// (13.5, ½, ½), radius √3/2). The root is their union: centres 3 apart, equal radii, so
+    /// its centre is the midpoint (12, ½, ½) and its radius 1.5 + r, grown by 4ε. The SAH
+    /// splits (a leaf of two costs 2R² ≈ 11.2, the split R² + 2r² ≈ 7.1, with R ≈ 2.37 and
+    /// r ≈ 0.87): the root over two leaves of one cube each.
+    #[test]
+    fn build_by_hand() {
+        let b = SphereBvh::build(&Cubes(2), &BuildOptions::default());
+        let r = 0.5 * 3f32.sqrt() + 2f32.powi(-16);
+        let big = (1.5 + r) * (1.0 + 4.0 * f32::EPSILON);
+        assert_eq!(b.nodes.len(), 3);
+        assert_eq!((b.nodes[0].center, b.nodes[0].left_first, b.nodes[0].count), ([12.0, 0.5, 0.5], 1, 0));
+        assert!((b.nodes[0].radius - big).abs() < 1e-6, "root radius {} vs {big}", b.nodes[0].radius);
+        for (k, x) in [(1, 10.5), (2, 13.5)] {
+            let n = b.nodes[k];
+            assert_eq!((n.center, n.count), ([x, 0.5, 0.5], 1), "node {k}");
+            assert!((n.radius - r).abs() < 1e-6, "node {k}: radius {} vs {r}", n.radius);
+            let first = n.left_first as usize;
+            assert_eq!(b.indices[first..first + 1], [k as u32 - 1], "node {k}");
+        }
+        assert_eq!(b.primitives, 2);
+        b.validate(&Cubes(2)).unwrap();
+        // One cube: a single leaf, grown by 2⁻¹⁸ (extent 1). No cube: no node.
+        let one = SphereBvh::build(&Cubes(1), &BuildOptions::default());
+        assert_eq!((one.nodes.len(), one.nodes[0].center, one.nodes[0].count, one.indices.clone()), (1, [10.5, 0.5, 0.5], 1, vec![0]));
+        assert!((one.nodes[0].radius - (0.5 * 3f32.sqrt() + 2f32.powi(-18))).abs() < 1e-7);
+        let none = SphereBvh::build(&Cubes(0), &BuildOptions::default());
+        assert!(none.nodes.is_empty() && none.indices.is_empty());
+    }
+
     #[test]
     fn sphere_containment_by_hand() {
         let outer = BoundingSphere { center: Vec3::new(5.0, 0.0, 0.0), radius: 2.0 };
@@ -270,6 +301,22 @@ mod tests {
         let mut fits = vec![node(1, 0), node(0, 1), node(1, 1)];
         fits[2] = SphereNode { center: [13.5, 0.5, 0.5], radius: 0.9, left_first: 1, count: 1 };
         check(fits, vec![0, 1], 2).unwrap();
+        // Off centre, at x = 13.4: the farthest corners, at x = 14, lie (0.6, ½, ½) away,
+        // √0.86 ≈ 0.9274: a radius of 0.9 misses them, 0.93 holds them.
+        let leaf = |x: f32, radius: f32| vec![node(1, 0), node(0, 1), SphereNode { center: [x, 0.5, 0.5], radius, left_first: 1, count: 1 }];
+        assert_eq!(check(leaf(13.4, 0.9), vec![0, 1], 2).unwrap_err(), "primitive 1 sticks out of leaf 2");
+        check(leaf(13.4, 0.93), vec![0, 1], 2).unwrap();
+        // The relative slack of 10⁻⁵ around the corners' distance √0.75 = 0.8660254 from the
+        // centre: 0.866022 (less by 3.9·10⁻⁶ of it) passes, 0.86601 (1.7·10⁻⁵) does not.
+        check(leaf(13.5, 0.866022), vec![0, 1], 2).unwrap();
+        assert_eq!(check(leaf(13.5, 0.86601), vec![0, 1], 2).unwrap_err(), "primitive 1 sticks out of leaf 2");
+        // Exactly at the slack: in f32, √0.75 rounds to 0x3F5DB3D7 and 1 + 10⁻⁵ to
+        // 1.0000100136 (0x3F800054); the radius 0x3F5DB346 ≈ 0.86601675 times that rounds to
+        // exactly 0x3F5DB3D7 (the product, exact in f64, is 0.8660254175, 2.9·10⁻⁸ from it and 3.0·10⁻⁸ from
+        // the next float up), so the corners lie on the bound: inside. One ulp less
+        // (0x3F5DB345) rounds below √0.75: outside.
+        check(leaf(13.5, f32::from_bits(0x3F5D_B346)), vec![0, 1], 2).unwrap();
+        assert_eq!(check(leaf(13.5, f32::from_bits(0x3F5D_B345)), vec![0, 1], 2).unwrap_err(), "primitive 1 sticks out of leaf 2");
         // Two interior nodes sharing children 3 and 4: node 4 is reached twice.
         let shared = vec![node(1, 0), node(3, 0), node(3, 0), node(0, 1), node(1, 1)];
         assert_eq!(check(shared, vec![0, 1], 2).unwrap_err(), "node 4 reached twice");

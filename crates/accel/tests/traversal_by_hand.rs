@@ -1088,3 +1088,84 @@ fn wide_statistics_of_leaves_of_several_blocks() {
         assert_eq!((s.name.as_str(), s.primitives, s.references), (kind.name(), 12, 12));
     }
 }
+
+/// Scene W with its triangles hidden: `triangle` answers `None` (the default), so the wide
+/// BVHs call `Primitives::intersect` (the same watertight test) for every lane, and the
+/// calls count the triangle tests a packet makes.
+struct Hidden<'a> {
+    soup: &'a Soup,
+    calls: std::sync::atomic::AtomicUsize,
+}
+
+impl Primitives for Hidden<'_> {
+    fn len(&self) -> usize {
+        self.soup.len()
+    }
+    fn bounds(&self, i: u32) -> Aabb {
+        pb(self.soup, i)
+    }
+    fn intersect(&self, i: u32, ray: &Ray) -> Option<raylab_accel::PrimHit> {
+        self.calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        self.soup.intersect(i, ray)
+    }
+}
+
+/// Scene W's one-node tree (`scene_w_tree`) with blocks flagging their primitive as not a
+/// triangle.
+fn scene_w_hidden<const W: usize>(soup: &Soup, kernel: Kernel) -> WideBvh<W> {
+    let mut w = scene_w_tree::<W>(soup, kernel);
+    for (p, b) in w.blocks.iter_mut().enumerate() {
+        *b = TriBlock::EMPTY_BLOCK;
+        b.prim[0] = p as u32 | TriBlock::OTHER;
+    }
+    w
+}
+
+/// Through `AnyAccel`, the wide BVHs trace a packet together, which is not its rays one by
+/// one: the packet takes children in the order of their least entry over its rays, so a ray
+/// may be charged (and test) a child that it alone would have dropped. Scene W on axis 0,
+/// rays at (−4, −2): `r1` along +a from c = 0 (alone: the root, lane 5 at ½ whose far half it
+/// misses, lane 2 at 1 hit; 3 visits, 2 tests), `r2` along −a from c = 5 (alone: the root,
+/// lane 1 at 1 hit; 2 visits, 1 test). Together, 8 wide, the least entries are lane 5: ½
+/// (r1's), lanes 1 and 2: 1 (r2's, r1's), lanes 0 and 3: 2. Both rays visit the root, lane 5
+/// (both miss), then lanes 1 and 2 in either order, each entered at 1, within both rays'
+/// limits all along (r1 hits lane 1 at t = 4 and lane 2 at 1, r2 lane 1 at 1 and lane 2 at
+/// 4 or not at all); lanes 0 and 3 (entry 2) are then beyond both: 8 visits and 6 tests,
+/// against 5 and 3 ray by ray. 4 wide (lanes 0–3: no lane 5): the root and lanes 1 and 2 for
+/// both, 6 visits and 4 tests, against 2 + 2 and 1 + 1. The quantised boxes move the
+/// entries by less than a grid step (3.5/255 along the axis), which changes none of this.
+/// With the triangles hidden, each test is a call.
+#[test]
+fn any_accel_traces_wide_packets_together() {
+    let soup = scene_w(0);
+    let hidden = Hidden { soup: &soup, calls: 0.into() };
+    let calls = || hidden.calls.swap(0, std::sync::atomic::Ordering::Relaxed);
+    let inf = f32::INFINITY;
+    let rays = [axis_ray(0, 1.0, 0.0, -4.0, -2.0, inf), axis_ray(0, -1.0, 5.0, -4.0, -2.0, inf)];
+    for kernel in kernels(8) {
+        let w8 = scene_w_hidden::<8>(&soup, kernel);
+        let q = quant_by_hand(&soup, &w8.nodes, w8.blocks.clone(), 0, kernel);
+        let w4 = scene_w_hidden::<4>(&soup, kernel);
+        for (accel, visits, tests) in [(AnyAccel::Bvh8(w8), 8, 6), (AnyAccel::Bvh8Q(q), 8, 6), (AnyAccel::Bvh4(w4), 6, 4)] {
+            assert!(accel.has_packets());
+            let mut out = [None; 2];
+            accel.intersect_packet(&hidden, &rays, &mut out);
+            assert_eq!(out.map(|h| h.map(|h| (h.prim, h.t))), [Some((2, 1.0)), Some((1, 1.0))], "{kernel:?}");
+            assert_eq!(calls(), tests as usize, "{kernel:?}: {visits} visits");
+            let mut out = [None; 2];
+            let mut c = Counters::default();
+            accel.intersect_packet_counted(&hidden, &rays, &mut out, &mut c);
+            assert_eq!(out.map(|h| h.map(|h| (h.prim, h.t))), [Some((2, 1.0)), Some((1, 1.0))], "{kernel:?}");
+            assert_eq!(c, Counters { rays: 2, nodes_visited: visits, prim_tests: tests, object_tests: 0 }, "{kernel:?}");
+            assert_eq!(calls(), tests as usize, "{kernel:?}: counted");
+            // Ray by ray: 3 + 2 visits and 2 + 1 tests 8 wide, 2 + 2 and 1 + 1 4 wide.
+            let mut single = Counters::default();
+            for (r, want) in rays.iter().zip([(2, 1.0), (1, 1.0)]) {
+                assert_eq!(accel.intersect(&hidden, r, &mut single).map(|h| (h.prim, h.t)), Some(want));
+            }
+            let alone = if visits == 8 { (5, 3) } else { (4, 2) };
+            assert_eq!((single.nodes_visited, single.prim_tests), alone, "{kernel:?}: ray by ray");
+            calls();
+        }
+    }
+}
