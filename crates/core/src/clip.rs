@@ -17,6 +17,8 @@ pub fn triangle_bounds(v: [Vec3; 3], clip: &Aabb) -> Aabb {
     let whole = Aabb::from_points(v);
     // Planes the whole triangle lies inside cut nothing (clipping only shrinks it): the
     // usual case in a spatial split's bins, where only the bin's two planes cut.
+    // (A triangle touching a plane from inside is not cut by it; treating it as cut would
+    // give the same polygon.)
     let cuts = |axis: usize| (whole.min[axis] < clip.min[axis], whole.max[axis] > clip.max[axis]);
     if (0..3).all(|a| cuts(a) == (false, false)) {
         return whole.intersection(*clip);
@@ -103,5 +105,9 @@ mod tests {
         assert_eq!(triangle_bounds(t, &aabb([-5.0; 3], [5.0, 5.0, 1.0])), aabb([0.0; 3], [1.0, 1.0, 1.0]));
         // and by z ≥ 1: the quadrilateral (1,0,1), (2,0,2), (0,2,2), (0,1,1).
         assert_eq!(triangle_bounds(t, &aabb([-5.0, -5.0, 1.0], [5.0; 3])), aabb([0.0, 0.0, 1.0], [2.0, 2.0, 2.0]));
+        // Cut on all three axes, x ≥ 1/2, y ≥ 1/2, z ≤ 3/2: with p = (2s, 2t, 2(s + t)) that
+        // is s ≥ 1/4, t ≥ 1/4, s + t ≤ 3/4, the triangle (1/2, 1/2, 1), (1, 1/2, 3/2),
+        // (1/2, 1, 3/2); the triangle's box cut by the clip box would reach x, y = 2, z = 0.
+        assert_eq!(triangle_bounds(t, &aabb([0.5, 0.5, -5.0], [5.0, 5.0, 1.5])), aabb([0.5, 0.5, 1.0], [1.0, 1.0, 1.5]));
     }
 }
