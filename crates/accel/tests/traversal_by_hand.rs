@@ -846,10 +846,13 @@ fn triangle_filter_and_block_test_by_hand() {
     }
 }
 
-/// A soup that counts calls to `Primitives::intersect`.
+/// A soup that counts calls to `Primitives::intersect`. With `hide_triangles`, `triangle`
+/// answers `None` (the default), so the wide BVHs call `intersect` (the same watertight
+/// test) for every lane, and the calls count every triangle test.
 struct Counting<'a> {
     soup: &'a Soup,
     calls: std::sync::atomic::AtomicUsize,
+    hide_triangles: bool,
 }
 
 impl Primitives for Counting<'_> {
@@ -864,7 +867,7 @@ impl Primitives for Counting<'_> {
         self.soup.intersect(i, ray)
     }
     fn triangle(&self, i: u32) -> Option<[Vec3; 3]> {
-        self.soup.triangle(i)
+        if self.hide_triangles { None } else { self.soup.triangle(i) }
     }
 }
 
@@ -876,7 +879,7 @@ fn wide_bvh_calls_intersect_only_for_non_triangles() {
     let a = 0;
     let mut soup = Soup::triangles([near_half(a, 3.0, -16.0, -16.0), far_half(a, 2.0, -16.0, -16.0), near_half(a, 5.0, -16.0, -16.0), near_half(a, 1.0, -16.0, -16.0)]);
     soup.prims.push(Prim::Sphere { center: at(a, 8.0, -4.0, -2.0), radius: 1.0 });
-    let counting = Counting { soup: &soup, calls: 0.into() };
+    let counting = Counting { soup: &soup, calls: 0.into(), hide_triangles: false };
     let calls = || counting.calls.swap(0, std::sync::atomic::Ordering::Relaxed);
     for kernel in kernels(8) {
         let mut root = WideNode::<8>::EMPTY_NODE;
@@ -989,7 +992,7 @@ fn packets_prune_by_each_rays_far_limit() {
     let a = 0;
     let mut soup = Soup::triangles([far_half(a, 1.0, -16.0, -16.0)]);
     soup.prims.push(Prim::Sphere { center: at(a, 2.0, 10.0, 12.0), radius: 0.5 });
-    let counting = Counting { soup: &soup, calls: 0.into() };
+    let counting = Counting { soup: &soup, calls: 0.into(), hide_triangles: false };
     let calls = || counting.calls.swap(0, std::sync::atomic::Ordering::Relaxed);
     for kernel in kernels(8) {
         let mut root = WideNode::<8>::EMPTY_NODE;
@@ -1033,7 +1036,7 @@ fn packets_take_children_nearest_first() {
     let mut soup = Soup::triangles([far_half(a, 1.0, -16.0, -16.0)]);
     soup.prims.push(Prim::Sphere { center: at(a, 2.0, 10.0, 12.0), radius: 0.5 });
     soup.prims.push(Prim::Sphere { center: at(a, 3.5, 10.0, 12.0), radius: 0.5 });
-    let counting = Counting { soup: &soup, calls: 0.into() };
+    let counting = Counting { soup: &soup, calls: 0.into(), hide_triangles: false };
     let calls = || counting.calls.swap(0, std::sync::atomic::Ordering::Relaxed);
     for kernel in kernels(8) {
         let mut root = WideNode::<8>::EMPTY_NODE;
@@ -1089,27 +1092,6 @@ fn wide_statistics_of_leaves_of_several_blocks() {
     }
 }
 
-/// Scene W with its triangles hidden: `triangle` answers `None` (the default), so the wide
-/// BVHs call `Primitives::intersect` (the same watertight test) for every lane, and the
-/// calls count the triangle tests a packet makes.
-struct Hidden<'a> {
-    soup: &'a Soup,
-    calls: std::sync::atomic::AtomicUsize,
-}
-
-impl Primitives for Hidden<'_> {
-    fn len(&self) -> usize {
-        self.soup.len()
-    }
-    fn bounds(&self, i: u32) -> Aabb {
-        pb(self.soup, i)
-    }
-    fn intersect(&self, i: u32, ray: &Ray) -> Option<raylab_accel::PrimHit> {
-        self.calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        self.soup.intersect(i, ray)
-    }
-}
-
 /// Scene W's one-node tree (`scene_w_tree`) with blocks flagging their primitive as not a
 /// triangle.
 fn scene_w_hidden<const W: usize>(soup: &Soup, kernel: Kernel) -> WideBvh<W> {
@@ -1138,7 +1120,7 @@ fn scene_w_hidden<const W: usize>(soup: &Soup, kernel: Kernel) -> WideBvh<W> {
 #[test]
 fn any_accel_traces_wide_packets_together() {
     let soup = scene_w(0);
-    let hidden = Hidden { soup: &soup, calls: 0.into() };
+    let hidden = Counting { soup: &soup, calls: 0.into(), hide_triangles: true };
     let calls = || hidden.calls.swap(0, std::sync::atomic::Ordering::Relaxed);
     let inf = f32::INFINITY;
     let rays = [axis_ray(0, 1.0, 0.0, -4.0, -2.0, inf), axis_ray(0, -1.0, 5.0, -4.0, -2.0, inf)];
