@@ -195,12 +195,12 @@ fn tangent_frame_by_hand() {
     assert!(f.t.dot(Vec3::Z).abs() < 1e-6 && (f.t.length() - 1.0).abs() < 1e-6, "{}", f.t);
 }
 
-/// The 2 × 2 square (u along +x), every vertex normal `n` = (0, 0.6, 0.8) (the geometric
-/// normal is +z), bump-mapped by `scale` 0.1 with `height`.
-fn tilted_bump_square(uvs: [Vec2; 4], height: Texture) -> Scene {
+/// The 2 × 2 square (u along +x, ∂p/∂u = (2, 0, 0); the geometric normal +z), every vertex
+/// normal `n`, bump-mapped by `scale` 0.1 with `height`.
+fn tilted_bump_square(uvs: [Vec2; 4], n: Vec3, height: Texture) -> Scene {
     let mut mesh = square(uvs);
     mesh.positions.iter_mut().for_each(|p| *p *= 2.0);
-    mesh.normals = vec![Vec3::new(0.0, 0.6, 0.8); 4];
+    mesh.normals = vec![n; 4];
     with_map(mesh, height, |t| ShadingPerturbation::Bump { texture: t, scale: 0.1 })
 }
 
@@ -212,24 +212,26 @@ fn bump_map_slopes_in_u_and_v_on_a_tilted_shading_normal() {
     // so the heights h_u = 1.6 and h_v = 0.8 per unit of u and v, d = 0.1·h: 0.16 and 0.08.
     let texel = |m: f32| Rgb::new(0.5 * m, m, 1.5 * m);
     let map = || Texture::Image(ImageTexture::new(2, 2, vec![texel(0.4), texel(1.2), texel(0.0), texel(0.8)], Wrap::Clamp, Filter::Bilinear).unwrap());
-    let n = Vec3::new(0.0, 0.6, 0.8);
-    // ∂p/∂u = (2, 0, 0) lies in the shading plane; ∂p/∂v = (0, ±2, 0) does not: projected
-    // onto it (minus n(n·∂p/∂v) = ±1.2n) and kept 2 long, ±2·(0, 0.8, −0.6) = ±2b with
-    // b = n × x. Then ∂p'/∂u = 2x + 0.16n, ∂p'/∂v = ±2b + 0.08n, and their cross product,
-    // turned to n's side: 4n − 0.32x ∓ 0.16b (x × b = n, x × n = −b, b × n = x).
-    let (x, b) = (Vec3::X, Vec3::new(0.0, 0.8, -0.6));
+    // The shading normal n leans off +z across v (first) or across u (second). ∂p/∂u and
+    // ∂p/∂v = (0, ±2, 0) (v up or down) are projected onto n's plane (minus n(n·∂p)) and kept
+    // 2 long: 2t and ±2b, with t the unit projection of x and b = n × t:
+    // for n = (0, 0.6, 0.8), t = x and ∂p/∂v loses ±1.2n: ±2·(0, 0.8, −0.6) = ±2b;
+    // for n = (0.6, 0, 0.8), ∂p/∂u loses 1.2n: (1.28, 0, −0.96), 2t with t = (0.8, 0, −0.6),
+    // and b = y. Then ∂p'/∂u = 2t + 0.16n, ∂p'/∂v = ±2b + 0.08n, and their cross product,
+    // turned to n's side (t × b = n, t × n = −b, n × b = −t): ±(4n − 0.32t ∓ 0.16b).
     let at = Vec3::new(1.1, 0.9, 0.0);
-    // v up (u = 0.55, v = 0.45).
-    let s = tilted_bump_square(UP, map());
-    assert_close(ns_at(&s, at + Vec3::new(0.0, 0.0, 3.0), at), (4.0 * n - 0.32 * x - 0.16 * b).normalize(), 1e-4);
-    // v running down (u = 0.55, v = 0.55): ∂p/∂v = (0, −2, 0), and ∂p'/∂u × ∂p'/∂v points
-    // against n, so it is turned over.
-    let s = tilted_bump_square(V_FLIPPED, map());
-    assert_close(ns_at(&s, at + Vec3::new(0.0, 0.0, 3.0), at), (4.0 * n - 0.32 * x + 0.16 * b).normalize(), 1e-4);
-    // A constant height: the shading normal stays n on either winding of the uvs.
-    for uvs in [UP, V_FLIPPED] {
-        let s = tilted_bump_square(uvs, Texture::Constant(Rgb::new(0.1, 0.7, 0.3)));
-        assert_close(ns_at(&s, at + Vec3::new(0.0, 0.0, 3.0), at), n, 1e-5);
+    for (n, t, b) in [(Vec3::new(0.0, 0.6, 0.8), Vec3::X, Vec3::new(0.0, 0.8, -0.6)), (Vec3::new(0.6, 0.0, 0.8), Vec3::new(0.8, 0.0, -0.6), Vec3::Y)] {
+        // v up (u = 0.55, v = 0.45).
+        let s = tilted_bump_square(UP, n, map());
+        assert_close(ns_at(&s, at + Vec3::new(0.0, 0.0, 3.0), at), (4.0 * n - 0.32 * t - 0.16 * b).normalize(), 1e-4);
+        // v running down (u = 0.55, v = 0.55): ∂p'/∂u × ∂p'/∂v points against n, turned over.
+        let s = tilted_bump_square(V_FLIPPED, n, map());
+        assert_close(ns_at(&s, at + Vec3::new(0.0, 0.0, 3.0), at), (4.0 * n - 0.32 * t + 0.16 * b).normalize(), 1e-4);
+        // A constant height: the shading normal stays n on either winding of the uvs.
+        for uvs in [UP, V_FLIPPED] {
+            let s = tilted_bump_square(uvs, n, Texture::Constant(Rgb::new(0.1, 0.7, 0.3)));
+            assert_close(ns_at(&s, at + Vec3::new(0.0, 0.0, 3.0), at), n, 1e-5);
+        }
     }
 }
 
