@@ -314,4 +314,17 @@ mod tests {
         assert_eq!(colorize(&mut px, 40, 528), 12345.0);
         assert_image(&px, &expected(&v, 40, 12345.0, 22, 4, 484, "12345", 0), 40, "40 × 528");
     }
+
+    #[test]
+    fn colorize_labels_an_image_of_two_megapixels() {
+        // 2048 × 1152, the size of a real render (the pixel count times the width, 4.8·10⁹,
+        // is past u32): bar height min(1152 / 24 = 48, 24) = 24 (rows 1128..1152), dots
+        // (24 − 2) / 5 = 4 pixels, labels from row 1128 − (5·4 + 2) = 1106; costs 0..999,
+        // "999", 3·4·4 = 48 pixels wide, from column 2048 − 48 − 2 = 1998.
+        let (w, h) = (2048u32, 1152u32);
+        let v: Vec<f32> = (0..w * h).map(|i| (i % 1000) as f32).collect();
+        let mut px: Vec<Rgb> = v.iter().map(|&c| Rgb::splat(c)).collect();
+        assert_eq!(colorize(&mut px, w, h), 999.0);
+        assert_image(&px, &expected(&v, w, 999.0, 24, 4, 1106, "999", 1998), w as usize, "2048 × 1152");
+    }
 }
