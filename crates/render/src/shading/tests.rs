@@ -250,3 +250,34 @@ fn bump_map_of_a_solid_texture_steps_the_point_along_the_surface() {
     let at = Vec3::new(0.9993, 0.9991, 0.0);
     assert_close(ns_at(&s, at + Vec3::new(0.0, 0.0, 3.0), at), Vec3::new(-0.32, -0.32, 4.0).normalize(), 1e-3);
 }
+
+#[test]
+fn only_tangent_space_maps_need_tangents() {
+    let t = TextureId(0);
+    assert!(tangent_map(t).needs_tangents());
+    assert!(!ShadingPerturbation::NormalMap { texture: t, space: NormalSpace::Object }.needs_tangents());
+    assert!(!ShadingPerturbation::Bump { texture: t, scale: 0.1 }.needs_tangents());
+    // So `build_accel` computes per-vertex tangents (one per position) for the first only.
+    let tangents = |p: fn(TextureId) -> ShadingPerturbation| with_map(square(UP), Texture::Constant(Rgb::new(0.5, 0.5, 1.0)), p).geometry.meshes[0].tangents.len();
+    assert_eq!(tangents(tangent_map), 4);
+    assert_eq!(tangents(|t| ShadingPerturbation::NormalMap { texture: t, space: NormalSpace::Object }), 0);
+    assert_eq!(tangents(|t| ShadingPerturbation::Bump { texture: t, scale: 0.1 }), 0);
+}
+
+#[test]
+fn a_normal_below_the_surface_is_clamped_to_a_unit_vector_at_the_minimum_cosine() {
+    // ns = (1, 0, −1)/√2 under ng = z: its tangential direction x, lifted to the cosine 0.01:
+    // (√(1 − 0.01²), 0, 0.01) = (0.99994999..., 0, 0.01), of unit length.
+    let clamped = keep_above_surface(Vec3::new(1.0, 0.0, -1.0).normalize(), Vec3::Z);
+    assert_close(clamped, Vec3::new((1.0f64 - 1e-4).sqrt() as f32, 0.0, 0.01), 1e-6);
+    assert!((clamped.length() - 1.0).abs() < 1e-6, "{clamped}");
+    // Tilted off every axis: ng = (0, 0.6, 0.8), ns = −ng + 0.5·(1, 0, 0) normalised; its
+    // component across ng is along x, so the result is √(1 − 10⁻⁴)·x + 0.01·ng.
+    let ng = Vec3::new(0.0, 0.6, 0.8);
+    let clamped = keep_above_surface((Vec3::X * 0.5 - ng).normalize(), ng);
+    assert_close(clamped, (1.0f64 - 1e-4).sqrt() as f32 * Vec3::X + 0.01 * ng, 1e-6);
+    // Above the cosine, unchanged; exactly below the surface, ng itself.
+    let above = Vec3::new(0.6, 0.0, 0.8);
+    assert_eq!(keep_above_surface(above, Vec3::Z), above);
+    assert_eq!(keep_above_surface(-Vec3::Z, Vec3::Z), Vec3::Z);
+}
