@@ -18,7 +18,8 @@ raylab_core::named_enum!(NormalSpace, "normal space", {
 });
 
 /// A texel `c` in `[0, 1]³` (linear, never sRGB-decoded) to the unit normal `2c − 1`,
-/// renormalised because filtering and 8-bit storage shorten it. A black texel gives `+z`.
+/// renormalised because filtering and 8-bit storage shorten it. A mid-grey texel (½, ½, ½),
+/// the zero vector, gives `+z` (a black one gives (−1, −1, −1)/√3, below the surface).
 pub fn decode_normal(c: Rgb) -> Vec3 {
     (2.0 * c - Vec3::ONE).try_normalize().unwrap_or(Vec3::Z)
 }
