@@ -398,7 +398,7 @@ mod tests {
             g.validate(&prims).unwrap_err().message
         };
         assert_eq!(good.validate(&Boxes(prims.0[..3].to_vec())).unwrap_err().message, "built for 4 primitives, given 3");
-        assert_eq!(broken(&|g| drop(g.offsets.pop())), "64 offsets for 64 cells and 4 references");
+        assert_eq!(broken(&|g| { g.offsets.pop(); }), "64 offsets for 64 cells and 4 references");
         assert_eq!(broken(&|g| g.offsets[0] = 1), "65 offsets for 64 cells and 4 references");
         assert_eq!(broken(&|g| g.indices.push(0)), "65 offsets for 64 cells and 5 references");
         assert_eq!(broken(&|g| g.offsets[63] = 0), "offsets decrease at cell 62");

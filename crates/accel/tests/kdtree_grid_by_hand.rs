@@ -215,7 +215,6 @@ fn grid_walk_by_hand() {
     let (prims, opts) = scene_g();
     let g = Grid::build(&prims, &opts);
     let e = (2.0f32).powi(-20);
-    let inf = f32::INFINITY;
     let cases: Vec<(Ray, Answer, (bool, u64, u64))> = vec![
         // +x along the bars from x = −1: entered at x = −m, cell (0,1,0): prim 2 at t = 1.25,
         // prim 3 (z 0.85..0.9) missed; the cell's exit (t = 2 − m/2) lies beyond the hit.
