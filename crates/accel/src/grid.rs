@@ -339,5 +339,82 @@ mod tests {
         let thin = Aabb::new(Vec3::ZERO, Vec3::new(2.0, 1e-6, 1.0));
         assert_eq!(resolution(&thin, 1000, 4.0, 128), [89, 1, 45]);
         assert_eq!(resolution(&b, 0, 4.0, 128), [1, 1, 1]);
+        // Flat on the other axes too: √(4000 / 2) = 44.7 per unit.
+        assert_eq!(resolution(&Aabb::new(Vec3::ZERO, Vec3::new(2.0, 1.0, 0.0)), 1000, 4.0, 128), [89, 45, 1]);
+        assert_eq!(resolution(&Aabb::new(Vec3::ZERO, Vec3::new(0.0, 2.0, 1.0)), 1000, 4.0, 128), [1, 89, 45]);
+        // An axis worth exactly one cell stays in the budget: 100 × 100 × 0.6 at λN = 6000 is
+        // ∛(6000 / 6000) = 1 per unit: 100, 100 and round(0.6) = 1. (Dropping it would give
+        // √(6000 / 10⁴) = 0.77 per unit, 77 × 77.)
+        assert_eq!(resolution(&Aabb::new(Vec3::ZERO, Vec3::new(100.0, 100.0, 0.6)), 1500, 4.0, 128), [100, 100, 1]);
+        // No density: one cell per scene at least, ∛(1 / 2) = 0.79 per unit, 2 × 1 × 1.
+        assert_eq!(resolution(&b, 1000, 0.0, 128), [2, 1, 1]);
+    }
+
+    /// Boxes as primitives (no hits needed here).
+    struct Boxes(Vec<Aabb>);
+
+    impl Primitives for Boxes {
+        fn len(&self) -> usize {
+            self.0.len()
+        }
+        fn bounds(&self, i: u32) -> Aabb {
+            self.0[i as usize]
+        }
+        fn intersect(&self, _: u32, _: &Ray) -> Option<crate::PrimHit> {
+            None
+        }
+    }
+
+    /// Four boxes in [0, 4]³ at λ = 16: a 4 × 4 × 4 grid (cells of 1 + m/2, m = 9·2⁻¹⁹ the
+    /// margin), cell (x, y, z) at x + 4y + 16z. Prim 0 [0, ½]³ in cell 0; prim 3 (x, y
+    /// ¼..¾, z 3.25..3.75) in cell (0, 0, 3) = 48; prims 1 [3.5, 4]³ and 2 [3.25, 3.75]³ in
+    /// cell 63.
+    fn four() -> (Boxes, Grid) {
+        let b = |lo: [f32; 3], hi: [f32; 3]| Aabb::new(Vec3::from_array(lo), Vec3::from_array(hi));
+        let prims = Boxes(vec![b([0.0; 3], [0.5; 3]), b([3.5; 3], [4.0; 3]), b([3.25; 3], [3.75; 3]), b([0.25, 0.25, 3.25], [0.75, 0.75, 3.75])]);
+        let g = Grid::build(&prims, &BuildOptions { grid_density: 16.0, ..BuildOptions::default() });
+        (prims, g)
+    }
+
+    #[test]
+    fn cells_listed_by_hand() {
+        let (_, g) = four();
+        assert_eq!(g.res, [4, 4, 4]);
+        let mut offsets = vec![0];
+        offsets.extend([1; 48]);
+        offsets.extend([2; 15]);
+        offsets.push(4);
+        assert_eq!(g.offsets, offsets);
+        assert_eq!(g.indices, vec![0, 3, 1, 2]);
+    }
+
+    #[test]
+    fn validation_reports_each_broken_invariant() {
+        let (prims, good) = four();
+        good.validate(&prims).unwrap();
+        let broken = |f: &dyn Fn(&mut Grid)| {
+            let mut g = four().1;
+            f(&mut g);
+            g.validate(&prims).unwrap_err().message
+        };
+        assert_eq!(good.validate(&Boxes(prims.0[..3].to_vec())).unwrap_err().message, "built for 4 primitives, given 3");
+        assert_eq!(broken(&|g| { g.offsets.pop(); }), "64 offsets for 64 cells and 4 references");
+        assert_eq!(broken(&|g| g.offsets[0] = 1), "65 offsets for 64 cells and 4 references");
+        assert_eq!(broken(&|g| g.indices.push(0)), "65 offsets for 64 cells and 5 references");
+        assert_eq!(broken(&|g| g.offsets[63] = 0), "offsets decrease at cell 62");
+        assert_eq!(broken(&|g| g.indices[0] = 9), "cell 0 holds primitive 9 of 4");
+        assert_eq!(broken(&|g| g.indices[0] = 1), "primitive 1 does not overlap cell 0");
+        assert_eq!(broken(&|g| g.indices[3] = 1), "primitive 2 is in no cell");
+        let mut g = four().1;
+        g.primitives = 3;
+        assert_eq!(Accel::validate(&g, &prims).unwrap_err().accel, "grid");
+    }
+
+    /// The build time (set by `AnyAccel::build`) is passed on to the statistics.
+    #[test]
+    fn statistics_pass_the_build_time_on() {
+        let mut g = four().1;
+        g.build_ms = 1.25;
+        assert_eq!(g.stats().build_ms, 1.25);
     }
 }
