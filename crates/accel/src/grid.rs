@@ -350,20 +350,7 @@ mod tests {
         assert_eq!(resolution(&b, 1000, 0.0, 128), [2, 1, 1]);
     }
 
-    /// Boxes as primitives (no hits needed here).
-    struct Boxes(Vec<Aabb>);
-
-    impl Primitives for Boxes {
-        fn len(&self) -> usize {
-            self.0.len()
-        }
-        fn bounds(&self, i: u32) -> Aabb {
-            self.0[i as usize]
-        }
-        fn intersect(&self, _: u32, _: &Ray) -> Option<crate::PrimHit> {
-            None
-        }
-    }
+    use crate::primitives::TestBoxes as Boxes;
 
     /// Four boxes in [0, 4]³ at λ = 16: a 4 × 4 × 4 grid (cells of 1 + m/2, m = 9·2⁻¹⁹ the
     /// margin), cell (x, y, z) at x + 4y + 16z. Prim 0 [0, ½]³ in cell 0; prim 3 (x, y

@@ -74,3 +74,23 @@ pub trait Primitives: Sync {
 pub fn total_bounds<P: Primitives + ?Sized>(prims: &P) -> Aabb {
     (0..prims.len() as u32).fold(Aabb::EMPTY, |b, i| b.union(prims.bounds(i)))
 }
+
+/// Boxes as primitives for this crate's unit tests (the testkit's `Boxes` implements the
+/// trait of another build of this crate): a ray hits where it enters a box; clipping is the
+/// default `bounds ∩ clip`.
+#[cfg(test)]
+pub(crate) struct TestBoxes(pub Vec<Aabb>);
+
+#[cfg(test)]
+impl Primitives for TestBoxes {
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+    fn bounds(&self, i: u32) -> Aabb {
+        self.0[i as usize]
+    }
+    fn intersect(&self, i: u32, ray: &Ray) -> Option<PrimHit> {
+        let (t0, _) = self.0[i as usize].intersect_ray(ray)?;
+        (t0 > ray.t_min && t0 <= ray.t_max).then_some(PrimHit { t: t0, u: 0.0, v: 0.0 })
+    }
+}

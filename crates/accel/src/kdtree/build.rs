@@ -294,21 +294,7 @@ mod tests {
 
     // ------------------------------------------------------------ worked by hand (issue 15)
 
-    /// Boxes as primitives; clipping is the default `bounds ∩ clip`.
-    struct Boxes(Vec<Aabb>);
-
-    impl Primitives for Boxes {
-        fn len(&self) -> usize {
-            self.0.len()
-        }
-        fn bounds(&self, i: u32) -> Aabb {
-            self.0[i as usize]
-        }
-        fn intersect(&self, i: u32, ray: &Ray) -> Option<PrimHit> {
-            let (t0, _) = self.0[i as usize].intersect_ray(ray)?;
-            (t0 > ray.t_min && t0 <= ray.t_max).then_some(PrimHit { t: t0, u: 0.0, v: 0.0 })
-        }
-    }
+    use crate::primitives::TestBoxes as Boxes;
 
     fn aabb(min: [f32; 3], max: [f32; 3]) -> Aabb {
         Aabb::new(Vec3::from_array(min), Vec3::from_array(max))
