@@ -1,5 +1,5 @@
 //! Top-down builders. Subtrees are built in parallel (`rayon::join`) into a temporary
-//! tree, which is then flattened depth-first with siblings adjacent.
+//! tree, which is then flattened depth-first with siblings adjacent, in parallel too.
 //!
 //! Primitives travel as [`PrimRef`]s, box and index together (Embree's layout), which the
 //! splits partition in place: binning and partitioning stream through memory instead of
@@ -23,7 +23,17 @@ const BIN_CHUNK: usize = 1 << 13;
 
 enum BuildNode {
     Leaf { bounds: Aabb, first: u32, count: u32 },
-    Interior { bounds: Aabb, children: Box<[BuildNode; 2]> },
+    /// `descendants`: the flat nodes below it, which [`flatten`] lays out.
+    Interior { bounds: Aabb, children: Box<[BuildNode; 2]>, descendants: usize },
+}
+
+impl BuildNode {
+    fn descendants(&self) -> usize {
+        match self {
+            BuildNode::Leaf { .. } => 0,
+            BuildNode::Interior { descendants, .. } => *descendants,
+        }
+    }
 }
 
 /// A primitive's box and its index in the input.
@@ -136,23 +146,30 @@ pub(super) fn build<P: Primitives + ?Sized>(prims: &P, method: SplitMethod, opts
     let ctx = Ctx { method, sah: SahCost::from_options(opts), max_leaf: opts.max_leaf_size.max(1), bins: opts.bins.clamp(2, 256) };
     let extent = Extent::of(&refs);
     let root = ctx.build(&mut refs, extent, 0, 1, &mut Scratch::new(ctx.bins));
-    let mut nodes = Vec::with_capacity(2 * n);
-    nodes.push(BvhNode::interior(Aabb::EMPTY, 0));
-    flatten(root, 0, &mut nodes);
-    (nodes, refs.iter().map(|r| r.id).collect())
+    let mut nodes: Vec<BvhNode> = (0..1 + root.descendants()).into_par_iter().map(|_| BvhNode::interior(Aabb::EMPTY, 0)).collect();
+    let (top, below) = nodes.split_at_mut(1);
+    top[0] = flatten(root, 1, below);
+    (nodes, refs.par_iter().map(|r| r.id).collect())
 }
 
-fn flatten(node: BuildNode, slot: usize, nodes: &mut Vec<BvhNode>) {
+/// Lays out `node`'s subtree depth-first with siblings adjacent in `below` (whose first
+/// element is flat node `base`): its two children first, then the left child's
+/// descendants, then the right's. Returns `node` as a flat node. Subtrees are laid out in
+/// parallel (each writes its own part of `below`), in the serial order.
+fn flatten(node: BuildNode, base: usize, below: &mut [BvhNode]) -> BvhNode {
     match node {
-        BuildNode::Leaf { bounds, first, count } => nodes[slot] = BvhNode::leaf(bounds, first, count),
-        BuildNode::Interior { bounds, children } => {
-            let left = nodes.len();
-            nodes[slot] = BvhNode::interior(bounds, left as u32);
-            nodes.push(BvhNode::interior(Aabb::EMPTY, 0));
-            nodes.push(BvhNode::interior(Aabb::EMPTY, 0));
+        BuildNode::Leaf { bounds, first, count } => BvhNode::leaf(bounds, first, count),
+        BuildNode::Interior { bounds, children, descendants } => {
             let [l, r] = *children;
-            flatten(l, left, nodes);
-            flatten(r, left + 1, nodes);
+            let (pair, rest) = below.split_at_mut(2);
+            let (l_below, r_below) = rest.split_at_mut(l.descendants());
+            let (l_base, r_base) = (base + 2, base + 2 + l.descendants());
+            (pair[0], pair[1]) = if descendants >= PARALLEL_THRESHOLD {
+                rayon::join(|| flatten(l, l_base, l_below), || flatten(r, r_base, r_below))
+            } else {
+                (flatten(l, l_base, l_below), flatten(r, r_base, r_below))
+            };
+            BvhNode::interior(bounds, base as u32)
         }
     }
 }
@@ -187,7 +204,8 @@ impl Ctx {
         } else {
             (self.build(l, le, offset, depth + 1, scratch), self.build(r, re, offset + mid, depth + 1, scratch))
         };
-        BuildNode::Interior { bounds, children: Box::new([left, right]) }
+        let descendants = 2 + left.descendants() + right.descendants();
+        BuildNode::Interior { bounds, children: Box::new([left, right]), descendants }
     }
 
     /// Partitions `refs`, or `None` for a leaf.

@@ -12,12 +12,21 @@
 use rayon::prelude::*;
 use raylab_core::{Aabb, Vec3};
 
-use super::node::{leaf_ref, ChildRef, TriBlock, WideNode, MAX_BLOCKS, MAX_LEAF_BLOCKS};
+use super::node::{is_leaf, leaf_blocks, leaf_ref, ChildRef, TriBlock, WideNode, EMPTY, MAX_BLOCKS, MAX_LEAF_BLOCKS};
 use crate::bvh::{Bvh, BvhNode};
+use crate::par::DisjointSlice;
 use crate::Primitives;
 
-/// Subtrees with at most this many references may become a single leaf (two [`TriBlock`]s).
+/// Subtrees of at most this many references may become a single leaf (two [`TriBlock`]s).
 pub const LEAF_PRIMS: usize = 8;
+
+/// Wide nodes over at least this many references emit their children's subtrees as
+/// parallel tasks, each into buffers of its own, appended in lane order afterwards: the
+/// serial emission's layout, whatever the thread count.
+const FORK_REFS: usize = 16 * 1024;
+
+/// The plan's bottom-up pass forks at binary nodes above this depth.
+const FORK_DEPTH: usize = 12;
 
 pub(super) struct Collapsed<const W: usize> {
     pub nodes: Vec<WideNode<W>>,
@@ -33,33 +42,35 @@ struct Ctx<'a, P: ?Sized, const W: usize> {
     /// Each primitive's vertices (`None`: not a triangle), read in the mesh's order once:
     /// leaves then fetch one record per triangle instead of four dependent loads.
     triangles: Vec<Option<[Vec3; 3]>>,
-    /// References below each binary node.
-    counts: Vec<usize>,
     /// The dynamic programme's choices per binary node (see [`plan`]).
     plan: Vec<Plan<W>>,
+    fork_refs: usize,
+}
+
+/// Wide nodes and triangle blocks emitted by one task; its references count from 0.
+struct Out<const W: usize> {
     nodes: Vec<WideNode<W>>,
     blocks: Vec<TriBlock>,
 }
 
 pub(super) fn collapse<P: Primitives + ?Sized, const W: usize>(bvh: &Bvh, prims: &P) -> Collapsed<W> {
+    collapse_forking(bvh, prims, FORK_REFS)
+}
+
+/// [`collapse`], forking the emission at wide nodes over `fork_refs` references or more
+/// (tests compare forking everywhere with never).
+fn collapse_forking<P: Primitives + ?Sized, const W: usize>(bvh: &Bvh, prims: &P, fork_refs: usize) -> Collapsed<W> {
     assert!(prims.len() < TriBlock::OTHER as usize, "wide BVH: more than 2^31 primitives");
     let bin = &bvh.nodes[..];
     if bin.is_empty() {
-        return Collapsed { nodes: Vec::new(), blocks: Vec::new(), root: super::node::EMPTY, root_bounds: Aabb::EMPTY };
+        return Collapsed { nodes: Vec::new(), blocks: Vec::new(), root: EMPTY, root_bounds: Aabb::EMPTY };
     }
-    // Children always sit after their parent (checked by `Bvh::validate`), so a reverse
-    // sweep sees children before parents.
-    let mut counts = vec![0usize; bin.len()];
-    for i in (0..bin.len()).rev() {
-        let n = &bin[i];
-        counts[i] = if n.is_leaf() { n.count as usize } else { counts[n.left_first as usize] + counts[n.left_first as usize + 1] };
-    }
-    let plan = plan::<W>(bin, &counts);
-    let triangles = (0..prims.len() as u32).into_par_iter().map(|p| prims.triangle(p)).collect();
-    let mut ctx = Ctx { bin, indices: &bvh.indices, prims, triangles, counts, plan, nodes: Vec::with_capacity(bin.len() / W + 1), blocks: Vec::with_capacity(prims.len() / 2 + 1) };
-    let root = ctx.child(0);
-    assert!(ctx.blocks.len() <= MAX_BLOCKS, "wide BVH: too many triangle blocks");
-    Collapsed { nodes: ctx.nodes, blocks: ctx.blocks, root, root_bounds: bin[0].bounds() }
+    let (plan, triangles) = rayon::join(|| plan::<W>(bin), || (0..prims.len() as u32).into_par_iter().map(|p| prims.triangle(p)).collect());
+    let ctx = Ctx { bin, indices: &bvh.indices, prims, triangles, plan, fork_refs };
+    let mut out = Out { nodes: Vec::with_capacity(bin.len() / W + 1), blocks: Vec::with_capacity(prims.len() / 2 + 1) };
+    let root = ctx.child(0, &mut out);
+    assert!(out.blocks.len() <= MAX_BLOCKS, "wide BVH: too many triangle blocks");
+    Collapsed { nodes: out.nodes, blocks: out.blocks, root, root_bounds: bin[0].bounds() }
 }
 
 /// What the dynamic programme chose for one binary node.
@@ -74,77 +85,132 @@ struct Plan<const W: usize> {
     /// When whole and not a leaf: the left child's share of the wide node's `W` slots.
     wide: u8,
     /// The subtree's cost, whole (the root's is the tree's SAH cost, times the root's area).
+    /// Only the tests read it back: they check the programme's sums by hand.
+    #[cfg_attr(not(test), allow(dead_code))]
     cost: f32,
+    /// References below the node.
+    refs: usize,
 }
 
-/// The dynamic programme, children before parents (a reverse sweep: children always sit
-/// after their parent). `cost[j - 1]` is the least cost of a subtree spread over at most `j`
-/// slots of its parent; a wide node costs its area, a leaf its area times its blocks.
-fn plan<const W: usize>(bin: &[BvhNode], counts: &[usize]) -> Vec<Plan<W>> {
-    let mut cost = vec![[0.0f32; W]; bin.len()];
-    let mut plan = vec![Plan { leaf: true, split: [0; W], wide: 0, cost: 0.0 }; bin.len()];
-    for i in (0..bin.len()).rev() {
-        let n = &bin[i];
-        let area = n.bounds().half_area().max(0.0);
-        let as_leaf = area * counts[i].div_ceil(4) as f32;
-        if n.is_leaf() {
-            cost[i] = [as_leaf; W];
-            plan[i].cost = as_leaf;
-            continue;
-        }
-        let (l, r) = (n.left_first as usize, n.left_first as usize + 1);
-        // spread[j - 1]: both children over at most j slots (j ≥ 2), and the left's share.
-        let mut spread = [(f32::INFINITY, 0u8); W];
-        for j in 2..=W {
-            for k in 1..j {
-                let c = cost[l][k - 1] + cost[r][j - k - 1];
-                if c < spread[j - 1].0 {
-                    spread[j - 1] = (c, k as u8);
-                }
-            }
-        }
-        let as_node = area + spread[W - 1].0;
-        let leaf = counts[i] <= LEAF_PRIMS && as_leaf <= as_node;
-        let whole = if leaf { as_leaf } else { as_node };
-        let mut p = Plan { leaf, split: [0; W], wide: spread[W - 1].1, cost: whole };
-        cost[i][0] = whole;
-        for j in 2..=W {
-            let (c, k) = spread[j - 1];
-            if c < whole {
-                cost[i][j - 1] = c;
-                p.split[j - 1] = k;
-            } else {
-                cost[i][j - 1] = whole;
-            }
-        }
-        plan[i] = p;
+/// The dynamic programme, children before parents. `cost[j - 1]` is the least cost of a
+/// subtree spread over at most `j` slots of its parent; a wide node costs its area, a leaf
+/// its area times its blocks. Subtrees near the root are planned in parallel.
+fn plan<const W: usize>(bin: &[BvhNode]) -> Vec<Plan<W>> {
+    let mut plan = vec![Plan { leaf: true, split: [0; W], wide: 0, cost: 0.0, refs: 0 }; bin.len()];
+    if !bin.is_empty() {
+        plan_subtree(bin, 0, 0, &DisjointSlice::new(&mut plan));
     }
     plan
 }
 
+/// Plans binary node `i` at `depth` and its subtree; returns its references and `cost`.
+fn plan_subtree<const W: usize>(bin: &[BvhNode], i: usize, depth: usize, plan: &DisjointSlice<Plan<W>>) -> (usize, [f32; W]) {
+    let n = &bin[i];
+    let area = n.bounds().half_area().max(0.0);
+    if n.is_leaf() {
+        let refs = n.count as usize;
+        let as_leaf = area * refs.div_ceil(4) as f32;
+        // SAFETY: each node is planned once, by the one task that holds its subtree.
+        unsafe { plan.write(i, Plan { leaf: true, split: [0; W], wide: 0, cost: as_leaf, refs }) };
+        return (refs, [as_leaf; W]);
+    }
+    let (l, r) = (n.left_first as usize, n.left_first as usize + 1);
+    let ((refs_l, cost_l), (refs_r, cost_r)) = if depth < FORK_DEPTH {
+        rayon::join(|| plan_subtree(bin, l, depth + 1, plan), || plan_subtree(bin, r, depth + 1, plan))
+    } else {
+        (plan_subtree(bin, l, depth + 1, plan), plan_subtree(bin, r, depth + 1, plan))
+    };
+    let refs = refs_l + refs_r;
+    let as_leaf = area * refs.div_ceil(4) as f32;
+    // spread[j - 1]: both children over at most j slots (j ≥ 2), and the left's share.
+    let mut spread = [(f32::INFINITY, 0u8); W];
+    for j in 2..=W {
+        for k in 1..j {
+            let c = cost_l[k - 1] + cost_r[j - k - 1];
+            if c < spread[j - 1].0 {
+                spread[j - 1] = (c, k as u8);
+            }
+        }
+    }
+    let as_node = area + spread[W - 1].0;
+    let leaf = refs <= LEAF_PRIMS && as_leaf <= as_node;
+    let whole = if leaf { as_leaf } else { as_node };
+    let mut p = Plan { leaf, split: [0; W], wide: spread[W - 1].1, cost: whole, refs };
+    let mut cost = [whole; W];
+    for j in 2..=W {
+        let (c, k) = spread[j - 1];
+        if c < whole {
+            cost[j - 1] = c;
+            p.split[j - 1] = k;
+        }
+    }
+    // SAFETY: as for the leaves above.
+    unsafe { plan.write(i, p) };
+    (refs, cost)
+}
+
+impl<const W: usize> Out<W> {
+    fn new() -> Self {
+        Self { nodes: Vec::new(), blocks: Vec::new() }
+    }
+
+    /// Appends what another task emitted, its references moved past ours; returns its
+    /// root's reference here.
+    fn append(&mut self, root: ChildRef, part: Out<W>) -> ChildRef {
+        let (node_base, block_base) = (self.nodes.len() as u32, self.blocks.len());
+        let moved = |r: ChildRef| match r {
+            EMPTY => EMPTY,
+            r if is_leaf(r) => {
+                let (first, count) = leaf_blocks(r);
+                leaf_ref(first + block_base, count)
+            }
+            r => r + node_base,
+        };
+        self.nodes.extend(part.nodes.into_iter().map(|mut n| {
+            n.child = n.child.map(moved);
+            n
+        }));
+        self.blocks.extend_from_slice(&part.blocks);
+        moved(root)
+    }
+}
+
 impl<P: Primitives + ?Sized, const W: usize> Ctx<'_, P, W> {
     /// The reference for binary node `i`, whole: a leaf or a wide node, as planned.
-    fn child(&mut self, i: usize) -> ChildRef {
+    fn child(&self, i: usize, out: &mut Out<W>) -> ChildRef {
         let n = &self.bin[i];
         if n.is_leaf() || self.plan[i].leaf {
-            let mut refs = Vec::with_capacity(self.counts[i]);
+            let mut refs = Vec::with_capacity(self.plan[i].refs);
             self.gather(i, &mut refs);
             // Spatial splits may put one primitive in two leaves of a merged subtree.
             refs.sort_unstable();
             refs.dedup();
-            return self.leaf(&refs, n.bounds());
+            return self.leaf(&refs, n.bounds(), out);
         }
         let l = n.left_first as usize;
         let k = self.plan[i].wide as usize;
         let mut open = Vec::with_capacity(W);
         self.slots(l, k, &mut open);
         self.slots(l + 1, W - k, &mut open);
-        let slot = self.nodes.len();
-        self.nodes.push(WideNode::EMPTY_NODE);
-        for (lane, &c) in open.iter().enumerate() {
-            let r = self.child(c);
-            let b = self.bin[c].bounds();
-            self.nodes[slot].set(lane, &b, r);
+        let slot = out.nodes.len();
+        out.nodes.push(WideNode::EMPTY_NODE);
+        if self.plan[i].refs >= self.fork_refs {
+            let parts: Vec<(ChildRef, Out<W>)> = open
+                .par_iter()
+                .map(|&c| {
+                    let mut part = Out::new();
+                    (self.child(c, &mut part), part)
+                })
+                .collect();
+            for (lane, (&c, (r, part))) in open.iter().zip(parts).enumerate() {
+                let r = out.append(r, part);
+                out.nodes[slot].set(lane, &self.bin[c].bounds(), r);
+            }
+        } else {
+            for (lane, &c) in open.iter().enumerate() {
+                let r = self.child(c, out);
+                out.nodes[slot].set(lane, &self.bin[c].bounds(), r);
+            }
         }
         slot as ChildRef
     }
@@ -174,10 +240,10 @@ impl<P: Primitives + ?Sized, const W: usize> Ctx<'_, P, W> {
     /// A leaf over `refs` inside `bounds`; leaves too large for one reference (more than
     /// [`MAX_LEAF_BLOCKS`] blocks, from builders that cannot split equal centroids) become
     /// a wide node over chunks.
-    fn leaf(&mut self, refs: &[u32], bounds: Aabb) -> ChildRef {
+    fn leaf(&self, refs: &[u32], bounds: Aabb, out: &mut Out<W>) -> ChildRef {
         let blocks = refs.len().div_ceil(4);
         if blocks <= MAX_LEAF_BLOCKS {
-            let first = self.blocks.len();
+            let first = out.blocks.len();
             for chunk in refs.chunks(4) {
                 let mut b = TriBlock::EMPTY_BLOCK;
                 for (lane, &p) in chunk.iter().enumerate() {
@@ -186,17 +252,17 @@ impl<P: Primitives + ?Sized, const W: usize> Ctx<'_, P, W> {
                         None => b.prim[lane] = p | TriBlock::OTHER,
                     }
                 }
-                self.blocks.push(b);
+                out.blocks.push(b);
             }
             return leaf_ref(first, blocks);
         }
         let per = refs.len().div_ceil(W);
-        let slot = self.nodes.len();
-        self.nodes.push(WideNode::EMPTY_NODE);
+        let slot = out.nodes.len();
+        out.nodes.push(WideNode::EMPTY_NODE);
         for (lane, chunk) in refs.chunks(per).enumerate() {
             let cb = chunk.iter().fold(Aabb::EMPTY, |b, &p| b.union(self.prims.bounds(p))).intersection(bounds);
-            let r = self.leaf(chunk, cb);
-            self.nodes[slot].set(lane, &cb, r);
+            let r = self.leaf(chunk, cb, out);
+            out.nodes[slot].set(lane, &cb, r);
         }
         slot as ChildRef
     }
@@ -212,13 +278,31 @@ mod tests {
         Aabb::new(Vec3::ZERO, Vec3::new(x, y, z))
     }
 
-    fn counts(bin: &[BvhNode]) -> Vec<usize> {
-        let mut c = vec![0; bin.len()];
-        for i in (0..bin.len()).rev() {
-            let n = &bin[i];
-            c[i] = if n.is_leaf() { n.count as usize } else { c[n.left_first as usize] + c[n.left_first as usize + 1] };
+    /// Forking the emission changes who writes what, never the result: a tree collapsed
+    /// with every wide node forking, or some, is the same bytes as one never forking.
+    #[test]
+    fn forking_emits_the_serial_layout() {
+        let mut seed = 12345u32;
+        let mut next = move || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1 << 24) as f32
+        };
+        let boxes: Vec<Aabb> = (0..3000)
+            .map(|_| {
+                let p = Vec3::new(next(), next(), next()) * 10.0;
+                Aabb::new(p, p + Vec3::new(next(), next(), next()) * 0.3)
+            })
+            .collect();
+        let prims = crate::primitives::TestBoxes(boxes);
+        let bvh = Bvh::build(&prims, crate::bvh::SplitMethod::BinnedSah, &crate::BuildOptions::default());
+        let serial = collapse_forking::<_, 8>(&bvh, &prims, usize::MAX);
+        assert!(serial.nodes.len() > 50, "a tree deep enough to fork at several levels");
+        for fork_refs in [1, 64, 1000] {
+            let forked = collapse_forking::<_, 8>(&bvh, &prims, fork_refs);
+            assert_eq!(forked.root, serial.root);
+            assert!(forked.nodes == serial.nodes, "nodes differ when forking at {fork_refs} references");
+            assert!(forked.blocks == serial.blocks, "blocks differ when forking at {fork_refs} references");
         }
-        c
     }
 
     /// Two leaves of three filling their parent's box: as one leaf of two blocks the parent
@@ -227,12 +311,12 @@ mod tests {
     #[test]
     fn six_triangles_in_one_box_make_one_leaf() {
         let bin = [BvhNode::interior(aabb(1.0, 1.0, 1.0), 1), BvhNode::leaf(aabb(1.0, 1.0, 1.0), 0, 3), BvhNode::leaf(aabb(1.0, 1.0, 1.0), 3, 3)];
-        let whole = plan::<8>(&bin, &counts(&bin));
+        let whole = plan::<8>(&bin);
         assert!(whole[0].leaf);
         assert_eq!(whole[0].cost, 6.0);
         // Small children, half area 0.25 each (0.5 × 0.5 × 0): as a node 3 + 0.25 + 0.25 = 3.5 < 6.
         let bin = [BvhNode::interior(aabb(1.0, 1.0, 1.0), 1), BvhNode::leaf(aabb(0.5, 0.5, 0.0), 0, 3), BvhNode::leaf(aabb(0.5, 0.5, 0.0), 3, 3)];
-        assert!(!plan::<8>(&bin, &counts(&bin))[0].leaf);
+        assert!(!plan::<8>(&bin)[0].leaf);
     }
 
     /// Root R (half area 3) over A (interior, half area 2, over two leaves of eight, half area
@@ -252,7 +336,7 @@ mod tests {
         for (i, want) in [3.0, 2.0, 1.0, 1.0, 1.0].into_iter().enumerate() {
             assert_eq!(bin[i].bounds().half_area(), want, "node {i}");
         }
-        let plan = plan::<4>(&bin, &counts(&bin));
+        let plan = plan::<4>(&bin);
         assert_eq!((plan[0].cost, plan[1].cost, plan[2].cost), (8.0, 6.0, 1.0));
         assert!(!plan[0].leaf && !plan[1].leaf, "20 and 16 references are too many for a leaf");
         assert_eq!(plan[0].wide, 2, "A takes two of R's four slots");
@@ -283,7 +367,7 @@ mod tests {
             BvhNode::leaf(leaf, 28, 8),
         ];
         assert_eq!(c.half_area(), 1.5);
-        let plan = plan::<4>(&bin, &counts(&bin));
+        let plan = plan::<4>(&bin);
         assert_eq!(plan.iter().map(|p| p.cost).collect::<Vec<_>>(), [13.5, 1.0, 10.0, 5.5, 5.5, 2.0, 2.0, 2.0, 2.0]);
         assert_eq!(plan[0].wide, 1, "A takes one of R's slots, B three");
         assert_eq!(plan[2].split[2], 1, "B over three slots: C1 whole, C2 over two");

@@ -17,6 +17,7 @@ mod packet;
 pub mod quant;
 mod traverse;
 
+use rayon::prelude::*;
 use raylab_core::{Aabb, Ray};
 
 use crate::bvh::Bvh;
@@ -209,9 +210,13 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
 
 /// Lays out `nodes` as `N`, children before parents, each interior lane's box widened to
 /// the union of its child's decoded boxes: a layout that rounds boxes outward (quantised)
-/// then still nests every box in its parent's, which validation checks. For f32 boxes the
-/// union is the lane's own box, so nothing changes.
+/// then still nests every box in its parent's, which validation checks. For an exact
+/// layout (f32 boxes) the union is the lane's own box: the nodes convert one by one, in
+/// parallel.
 fn encode<const W: usize, N: Layout<W>>(nodes: &[WideNode<W>], root: ChildRef) -> Vec<N> {
+    if N::EXACT {
+        return nodes.par_iter().map(N::encode).collect();
+    }
     let mut preorder = Vec::with_capacity(nodes.len());
     let mut stack = vec![root];
     while let Some(r) = stack.pop() {

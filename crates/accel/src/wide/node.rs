@@ -78,6 +78,10 @@ pub trait Layout<const W: usize>: Copy + std::fmt::Debug + Send + Sync + 'static
     /// Short name for statistics ("f32", "quantised").
     const NAME: &'static str;
 
+    /// Decoding gives back exactly the encoded boxes: no parent's box needs widening to
+    /// hold its children's decoded ones.
+    const EXACT: bool;
+
     /// Lays out `node`. A decoded box contains the original one (it may only grow).
     fn encode(node: &WideNode<W>) -> Self;
 
@@ -94,6 +98,7 @@ pub trait Layout<const W: usize>: Copy + std::fmt::Debug + Send + Sync + 'static
 
 impl<const W: usize> Layout<W> for WideNode<W> {
     const NAME: &'static str = "f32";
+    const EXACT: bool = true;
 
     fn encode(node: &WideNode<W>) -> Self {
         *node

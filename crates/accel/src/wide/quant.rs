@@ -56,6 +56,7 @@ fn finite(x: f32) -> f32 {
 
 impl Layout<8> for QuantNode {
     const NAME: &'static str = "quantised";
+    const EXACT: bool = false;
 
     fn encode(n: &WideNode<8>) -> Self {
         let mut out = QuantNode { origin: [0.0; 3], exp: [127; 3], occupied: 0, q: [[255; 8], [255; 8], [255; 8], [0; 8], [0; 8], [0; 8]], child: [EMPTY; 8] };
