@@ -5,7 +5,9 @@
 #   build:  `raylab bench MESH --accels bvh,sbvh,lbvh,lbvh-ploc,bvh8 --peers embree --rays primary`
 #           on a tiny ray grid, for the build times of every builder and of Embree's qualities;
 #   render: `raylab render` of the bunny and dragon (Whitted) and the Cornell box (path traced),
-#           wall and user seconds of the whole command.
+#           wall and user seconds of the whole command;
+#   kernels (not run unless asked): `raylab trace --accel bvh8` with the AVX2 and the AVX-512
+#           kernel on the bench's ray sets, alternated twice, into $OUT/kernels.tsv.
 # Writes each run's table (.md) and JSON to $OUT, and $OUT/render.tsv (scene, threads, wall s,
 # user s, whether the image is byte for byte the first thread count's).
 # Settings (environment): RAYLAB (the binary; default: build target/release/raylab with
@@ -13,7 +15,8 @@
 # RAYLAB_SHARED (the shared `scenes` folder, default ../shared/scenes), OUT (default
 # target/scaling), THREADS (default "1 2 4 8 16"), MESHES (default "bunny dragon202k
 # dragon871k"), RESOLUTION (camera-ray grid of the trace sweep, default 1024), REPEATS
-# (default 3), SWEEPS (default "trace build render").
+# (default 3; trace's timed passes in the kernels sweep), SWEEPS (default "trace build
+# render"; add kernels).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SHARED=${RAYLAB_SHARED:-../shared/scenes}
@@ -68,7 +71,28 @@ for sweep in $SWEEPS; do
           fi
           printf '%s\t%s\t%s\t%s\n' "$1" "$t" "$times" "$same" | tee -a "$OUT/render.tsv"
         done ;;
-      *) echo "unknown sweep '$sweep' in SWEEPS (expected trace, build, render)" >&2; exit 2 ;;
+      kernels)
+        for m in $MESHES; do
+          p=$(path_of "$m")
+          rays="$OUT/rays-$m"
+          "$RAYLAB" bench "$p" --accels bvh8 --threads "$t" --repeats 1 --resolution "$RESOLUTION" --dump-rays "$rays/" > /dev/null 2>&1
+          stem=$(basename "$p"); stem=${stem%%.*}
+          for kind in primary diffuse shadow packets; do
+            case "$kind" in
+              shadow) args=(--rays "$rays/$stem-shadow.rays" --any-hit) ;;
+              packets) args=(--rays "$rays/$stem-primary.rays" --packet 16) ;;
+              *) args=(--rays "$rays/$stem-$kind.rays") ;;
+            esac
+            # Alternated twice: the machine's noise shows as the spread of each pair.
+            for k in simd avx512 simd avx512; do
+              echo "== kernels, $m, $kind, $k, $t thread(s)"
+              line=$("$RAYLAB" trace "$p" "${args[@]}" --accel bvh8 --kernel "$k" --threads "$t" --repeats "$REPEATS" 2>&1 | tail -1)
+              printf '%s\t%s\t%s\t%s\t%s\n' "$m" "$kind" "$k" "$t" "$(echo "$line" | grep -o '[0-9.]* Mrays/s' | cut -d' ' -f1)" | tee -a "$OUT/kernels.tsv"
+            done
+          done
+          rm -rf "$rays"
+        done ;;
+      *) echo "unknown sweep '$sweep' in SWEEPS (expected trace, build, render, kernels)" >&2; exit 2 ;;
     esac
   done
 done
