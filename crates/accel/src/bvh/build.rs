@@ -357,9 +357,19 @@ impl Bins {
     }
 }
 
-/// In-place partition: the primitives for which `left` holds move to the front, in the
-/// order of a single forward sweep of swaps; returns their number and both sides' extents.
-fn partition(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool) -> Split {
+/// Moves the primitives for which `left` holds to the front; returns their number and both
+/// sides' extents. Nodes of [`PARALLEL_BINNING`] primitives or more (the top of the tree,
+/// where few subtrees run side by side) partition in parallel.
+fn partition(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool + Sync) -> Split {
+    if refs.len() >= PARALLEL_BINNING {
+        partition_parallel(refs, left)
+    } else {
+        partition_serial(refs, left)
+    }
+}
+
+/// In place, in the order of a single forward sweep of swaps.
+fn partition_serial(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool) -> Split {
     let (mut le, mut re) = (Extent::EMPTY, Extent::EMPTY);
     let mut m = 0;
     for k in 0..refs.len() {
@@ -373,4 +383,91 @@ fn partition(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool) -> Split {
         }
     }
     (m, le, re)
+}
+
+/// A stable partition in chunks of [`BIN_CHUNK`]: each chunk counts and bounds its two
+/// sides, prefix sums of the counts give each chunk its place on either side, and the
+/// chunks then copy their primitives there from a copy of the input, side by side. Both
+/// sides keep the input order, so the result does not depend on the thread count.
+fn partition_parallel(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool + Sync) -> Split {
+    let sides: Vec<(usize, Extent, Extent)> = refs
+        .par_chunks(BIN_CHUNK)
+        .map(|chunk| {
+            let (mut m, mut le, mut re) = (0, Extent::EMPTY, Extent::EMPTY);
+            for r in chunk {
+                if left(r) {
+                    le.add(r);
+                    m += 1;
+                } else {
+                    re.add(r);
+                }
+            }
+            (m, le, re)
+        })
+        .collect();
+    let (m, le, re) = sides.iter().fold((0, Extent::EMPTY, Extent::EMPTY), |(m, le, re), &(cm, cl, cr)| (m + cm, le.merge(cl), re.merge(cr)));
+    let input: Vec<PrimRef> = refs.par_iter().copied().collect();
+    let (mut lefts, mut rights) = refs.split_at_mut(m);
+    let mut places = Vec::with_capacity(sides.len());
+    for (chunk, &(cm, _, _)) in input.chunks(BIN_CHUNK).zip(&sides) {
+        let (l, l_rest) = std::mem::take(&mut lefts).split_at_mut(cm);
+        let (r, r_rest) = std::mem::take(&mut rights).split_at_mut(chunk.len() - cm);
+        places.push((l, r));
+        (lefts, rights) = (l_rest, r_rest);
+    }
+    input.par_chunks(BIN_CHUNK).zip(places).for_each(|(chunk, (l, r))| {
+        let (mut i, mut j) = (0, 0);
+        for p in chunk {
+            if left(p) {
+                l[i] = *p;
+                i += 1;
+            } else {
+                r[j] = *p;
+                j += 1;
+            }
+        }
+    });
+    (m, le, re)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn extents_equal(a: &Extent, b: &Extent) -> bool {
+        let eq = |x: &Box3, y: &Box3| x.min == y.min && x.max == y.max;
+        eq(&a.geom, &b.geom) && eq(&a.cent, &b.cent)
+    }
+
+    /// The parallel partition is the stable one: lefts then rights, each in input order,
+    /// with the extents of exactly those primitives, across chunk boundaries and at the
+    /// edges (nothing on one side).
+    #[test]
+    fn parallel_partition_is_stable_and_bounds_both_sides() {
+        let mut seed = 99u32;
+        let mut next = move || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1 << 24) as f32
+        };
+        let n = 3 * BIN_CHUNK + 5;
+        let input: Vec<PrimRef> = (0..n as u32)
+            .map(|id| {
+                let min = Vec3A::new(next(), next(), next()) * 100.0;
+                PrimRef { min, max: min + Vec3A::new(next(), next(), next()), id }
+            })
+            .collect();
+        for cut in [-1.0, 30.0, 50.0, 101.0] {
+            let left = |r: &PrimRef| r.centroid().x < cut;
+            let mut refs = input.clone();
+            let (m, le, re) = partition_parallel(&mut refs, left);
+            let want: Vec<u32> = input.iter().filter(|r| left(r)).chain(input.iter().filter(|r| !left(r))).map(|r| r.id).collect();
+            assert_eq!(refs.iter().map(|r| r.id).collect::<Vec<_>>(), want, "cut {cut}");
+            assert_eq!(m, input.iter().filter(|r| left(r)).count());
+            let bound = |part: &[PrimRef]| part.iter().fold(Extent::EMPTY, |mut e, r| {
+                e.add(r);
+                e
+            });
+            assert!(extents_equal(&le, &bound(&refs[..m])) && extents_equal(&re, &bound(&refs[m..])), "cut {cut}");
+        }
+    }
 }
