@@ -15,6 +15,7 @@ pub mod counters;
 pub mod grid;
 pub mod kdtree;
 mod leaf;
+mod par;
 pub mod primitives;
 pub mod sphere_bvh;
 pub mod stats;
