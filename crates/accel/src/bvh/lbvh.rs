@@ -136,7 +136,7 @@ pub(crate) fn emit<V: Volume>(mut tree: Tree<V>, sah: SahCost, max_leaf: usize) 
     if tree.nodes.is_empty() {
         return (Vec::new(), Vec::new());
     }
-    debug_assert!(is_tree(&tree), "emit: a node is the child of several nodes, or the root of one");
+    debug_assert!(is_tree(&tree), "emit: not a tree (a node with several parents, or a root with one)");
     let root = tree.root;
     let mut summaries: Vec<Summary> = (0..tree.nodes.len()).into_par_iter().map(|_| Summary::default()).collect();
     let pass = BottomUp { nodes: &tree.nodes, volumes: DisjointSlice::new(&mut tree.volumes), summaries: DisjointSlice::new(&mut summaries), sah, max_leaf };
@@ -151,8 +151,9 @@ pub(crate) fn emit<V: Volume>(mut tree: Tree<V>, sah: SahCost, max_leaf: usize) 
     (nodes, indices)
 }
 
-/// Whether every node but the root is the child of exactly one interior node, and the root
-/// of none (the [`Tree`] invariant that [`emit`]'s bottom-up pass relies on for safety).
+/// Whether every node but the root is the child of at most one interior node, and the root
+/// the child of none: the part of the [`Tree`] invariant that makes the subtrees of two
+/// siblings disjoint, which [`emit`]'s bottom-up pass relies on for safety.
 fn is_tree<V>(tree: &Tree<V>) -> bool {
     let mut parents = vec![0u8; tree.nodes.len()];
     for n in &tree.nodes {
