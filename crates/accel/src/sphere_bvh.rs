@@ -70,7 +70,7 @@ impl SphereBvh {
         let tree = ploc::cluster(&spheres, &centers, opts.ploc_radius);
         let (flat, indices) = lbvh::emit(tree, SahCost::from_options(opts), opts.max_leaf_size.max(1));
         let nodes = flat
-            .into_iter()
+            .into_par_iter()
             .map(|f| SphereNode { center: f.volume.center.to_array(), radius: f.volume.radius, left_first: f.left_first, count: f.count })
             .collect();
         Self { nodes, indices, primitives: n, build_ms: 0.0 }
