@@ -2,7 +2,7 @@
 //! tree, which is then flattened depth-first with siblings adjacent, in parallel too.
 //!
 //! Primitives travel as [`PrimRef`]s, box and index together (Embree's layout), which the
-//! splits partition in place: binning and partitioning stream through memory instead of
+//! splits partition (stably, in parallel at the top of the tree): binning and partitioning stream through memory instead of
 //! following an index into separate box and centroid arrays, and a partition hands each
 //! side its box and its centroids' box, so no node reads its primitives again to bound them.
 
@@ -20,6 +20,9 @@ const PARALLEL_THRESHOLD: usize = 4096;
 /// levels of the tree, where `rayon::join` over subtrees has not yet spread the work).
 const PARALLEL_BINNING: usize = 1 << 15;
 const BIN_CHUNK: usize = 1 << 13;
+
+/// Threads from which large nodes partition in parallel (see [`partition`]).
+const PARALLEL_PARTITION_THREADS: usize = 4;
 
 enum BuildNode {
     Leaf { bounds: Aabb, first: u32, count: u32 },
@@ -180,11 +183,13 @@ struct Scratch {
     bins: Bins,
     right_area: Vec<f32>,
     right_count: Vec<usize>,
+    /// The right side of a serial partition, on its way to the back.
+    rights: Vec<PrimRef>,
 }
 
 impl Scratch {
     fn new(nb: usize) -> Self {
-        Self { bins: Bins::new(nb), right_area: vec![0.0; nb], right_count: vec![0; nb] }
+        Self { bins: Bins::new(nb), right_area: vec![0.0; nb], right_count: vec![0; nb], rights: Vec::new() }
     }
 }
 
@@ -225,7 +230,7 @@ impl Ctx {
                     return None;
                 }
                 let mid = 0.5 * (cb.min[axis] + cb.max[axis]);
-                let split = partition(refs, |r| r.centroid()[axis] < mid);
+                let split = partition(refs, |r| r.centroid()[axis] < mid, &mut scratch.rights);
                 Some(if split.0 == 0 || split.0 == refs.len() { split_median(refs, axis) } else { split })
             }
         }
@@ -292,7 +297,7 @@ impl Ctx {
         // Bin `⌊clamp((c - lo) · s, 0, nb - 1)⌋ < plane` as one comparison: the plane is a
         // whole number at most `nb - 1`, and a NaN falls in bin 0, on the left.
         let (lo, s, plane_f) = (cb.min[axis], scale[axis], plane as f32);
-        let split = partition(refs, |r| !((r.centroid()[axis] - lo) * s >= plane_f));
+        let split = partition(refs, |r| !((r.centroid()[axis] - lo) * s >= plane_f), &mut scratch.rights);
         debug_assert!(split.0 > 0 && split.0 < refs.len());
         Some(split)
     }
@@ -357,31 +362,38 @@ impl Bins {
     }
 }
 
-/// Moves the primitives for which `left` holds to the front; returns their number and both
-/// sides' extents. Nodes of [`PARALLEL_BINNING`] primitives or more (the top of the tree,
-/// where few subtrees run side by side) partition in parallel.
-fn partition(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool + Sync) -> Split {
-    if refs.len() >= PARALLEL_BINNING {
+/// Moves the primitives for which `left` holds to the front, both sides in their input
+/// order (a stable partition); returns their number and both sides' extents. Nodes of
+/// [`PARALLEL_BINNING`] primitives or more (the top of the tree, where few subtrees run
+/// side by side) partition in parallel when there are [`PARALLEL_PARTITION_THREADS`]
+/// threads: the parallel partition makes three passes over memory to the serial one's one,
+/// and pays off only then. Both give the same order, so the tree does not depend on it.
+fn partition(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool + Sync, rights: &mut Vec<PrimRef>) -> Split {
+    if refs.len() >= PARALLEL_BINNING && rayon::current_num_threads() >= PARALLEL_PARTITION_THREADS {
         partition_parallel(refs, left)
     } else {
-        partition_serial(refs, left)
+        partition_serial(refs, left, rights)
     }
 }
 
-/// In place, in the order of a single forward sweep of swaps.
-fn partition_serial(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool) -> Split {
+/// One sweep: the left primitives move forward in place (a write never passes the read),
+/// the right ones wait in `rights` and follow.
+fn partition_serial(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool, rights: &mut Vec<PrimRef>) -> Split {
     let (mut le, mut re) = (Extent::EMPTY, Extent::EMPTY);
+    rights.clear();
     let mut m = 0;
     for k in 0..refs.len() {
         let r = refs[k];
         if left(&r) {
             le.add(&r);
-            refs.swap(k, m);
+            refs[m] = r;
             m += 1;
         } else {
             re.add(&r);
+            rights.push(r);
         }
     }
+    refs[m..].copy_from_slice(rights);
     (m, le, re)
 }
 
@@ -439,11 +451,11 @@ mod tests {
         eq(&a.geom, &b.geom) && eq(&a.cent, &b.cent)
     }
 
-    /// The parallel partition is the stable one: lefts then rights, each in input order,
-    /// with the extents of exactly those primitives, across chunk boundaries and at the
-    /// edges (nothing on one side).
+    /// Both partitions are the stable one: lefts then rights, each in input order, with the
+    /// extents of exactly those primitives, across chunk boundaries and at the edges
+    /// (nothing on one side).
     #[test]
-    fn parallel_partition_is_stable_and_bounds_both_sides() {
+    fn partitions_are_stable_and_bound_both_sides() {
         let mut seed = 99u32;
         let mut next = move || {
             seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
@@ -460,6 +472,10 @@ mod tests {
             let left = |r: &PrimRef| r.centroid().x < cut;
             let mut refs = input.clone();
             let (m, le, re) = partition_parallel(&mut refs, left);
+            let mut serial = input.clone();
+            let (ms, les, res) = partition_serial(&mut serial, left, &mut Vec::new());
+            assert!(serial.iter().map(|r| r.id).eq(refs.iter().map(|r| r.id)) && ms == m, "cut {cut}: the serial partition's order");
+            assert!(extents_equal(&les, &le) && extents_equal(&res, &re));
             let want: Vec<u32> = input.iter().filter(|r| left(r)).chain(input.iter().filter(|r| !left(r))).map(|r| r.id).collect();
             assert_eq!(refs.iter().map(|r| r.id).collect::<Vec<_>>(), want, "cut {cut}");
             assert_eq!(m, input.iter().filter(|r| left(r)).count());
