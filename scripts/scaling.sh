@@ -14,9 +14,9 @@
 # `--features peers,embree`, which needs Debian's libembree-dev, see scripts/peers.sh),
 # RAYLAB_SHARED (the shared `scenes` folder, default ../shared/scenes), OUT (default
 # target/scaling), THREADS (default "1 2 4 8 16"), MESHES (default "bunny dragon202k
-# dragon871k"), RESOLUTION (camera-ray grid of the trace sweep, default 1024), REPEATS
-# (default 3; trace's timed passes in the kernels sweep), SWEEPS (default "trace build
-# render"; add kernels).
+# dragon871k"; tetra adds a 4.2M-triangle procedural mesh), RESOLUTION (camera-ray grid of
+# the trace sweep, default 1024), REPEATS (default 3; trace's timed passes in the kernels
+# sweep), SWEEPS (default "trace build render"; add kernels).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SHARED=${RAYLAB_SHARED:-../shared/scenes}
@@ -32,14 +32,7 @@ if [ -z "${RAYLAB:-}" ]; then
 fi
 mkdir -p "$OUT"
 
-path_of() {
-  case "$1" in
-    bunny) echo "$SHARED/bunny_69451.obj" ;;
-    dragon202k) echo "$SHARED/dragon_vrip_res2.obj.gz" ;;
-    dragon871k) echo "$SHARED/dragon_vrip.obj.gz" ;;
-    *) echo "unknown mesh '$1' in MESHES (expected bunny, dragon202k, dragon871k)" >&2; exit 2 ;;
-  esac
-}
+. scripts/meshes.sh
 
 { echo "cores: $(nproc)"; grep -m1 'model name' /proc/cpuinfo || true; command -v lscpu >/dev/null && lscpu | grep -E '^(Thread|Core|Socket|NUMA node\(s\)|L3)' || true; } | tee "$OUT/machine.txt"
 

@@ -456,11 +456,8 @@ mod tests {
     /// (nothing on one side).
     #[test]
     fn partitions_are_stable_and_bound_both_sides() {
-        let mut seed = 99u32;
-        let mut next = move || {
-            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (seed >> 8) as f32 / (1 << 24) as f32
-        };
+        let mut rng = raylab_core::Pcg32::new(99, 0);
+        let mut next = move || rng.next_f32();
         let n = 3 * BIN_CHUNK + 5;
         let input: Vec<PrimRef> = (0..n as u32)
             .map(|id| {

@@ -145,13 +145,12 @@ mod tests {
     /// neighbours become new nodes in position order, at the lower one's position.
     #[test]
     fn chunked_merge_round_is_the_serial_sweep() {
-        let mut seed = 7u32;
+        let mut rng = raylab_core::Pcg32::new(7, 0);
         for _ in 0..200 {
-            let c = 2 + (seed % 40) as usize;
+            let c = 2 + rng.below(40) as usize;
             let nearest: Vec<usize> = (0..c)
                 .map(|i| {
-                    seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-                    let j = (seed >> 8) as usize % (c - 1);
+                    let j = rng.below(c as u32 - 1) as usize;
                     if j >= i { j + 1 } else { j }
                 })
                 .collect();

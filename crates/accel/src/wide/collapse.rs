@@ -282,11 +282,8 @@ mod tests {
     /// with every wide node forking, or some, is the same bytes as one never forking.
     #[test]
     fn forking_emits_the_serial_layout() {
-        let mut seed = 12345u32;
-        let mut next = move || {
-            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (seed >> 8) as f32 / (1 << 24) as f32
-        };
+        let mut rng = raylab_core::Pcg32::new(12345, 0);
+        let mut next = move || rng.next_f32();
         let boxes: Vec<Aabb> = (0..3000)
             .map(|_| {
                 let p = Vec3::new(next(), next(), next()) * 10.0;
