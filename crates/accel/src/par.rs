@@ -75,4 +75,25 @@ mod tests {
         assert_eq!(unsafe { s.get(3) }, 6);
         assert!(v.iter().enumerate().all(|(i, &x)| x as usize == if i % 2 == 0 { i } else { 2 * i }));
     }
+
+    /// One past the end panics, for `write` and `get`, rather than touching memory outside
+    /// the slice: the last element is written and read back, its neighbour left alone.
+    #[test]
+    fn accesses_past_the_end_panic() {
+        let mut backing = vec![7u32; 6];
+        {
+            let s = DisjointSlice::new(&mut backing[..5]);
+            // SAFETY: one writer.
+            unsafe { s.write(4, 9) };
+            // SAFETY: as above; out of range, so it must panic.
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| unsafe { s.write(5, 1) }));
+            assert!(r.is_err(), "index 5 of a slice of 5 must panic");
+            // SAFETY: no writer left.
+            assert_eq!(unsafe { s.get(4) }, 9);
+            // SAFETY: as above; out of range, so it must panic.
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| unsafe { s.get(5) }));
+            assert!(r.is_err(), "reading index 5 of a slice of 5 must panic");
+        }
+        assert_eq!(backing, [7, 7, 7, 7, 9, 7], "only element 4 changes");
+    }
 }
