@@ -342,6 +342,42 @@ mod tests {
         assert_eq!(plan[1].wide, 1);
     }
 
+    /// What the plans of the two trees above emit. Six references in one box: the root is
+    /// one leaf of two blocks (primitives 0..4 and 4, 5), no wide node. R over A (two leaves
+    /// of eight) and B (a leaf of four), 4 wide: one node whose lanes are A's leaves, then B,
+    /// then an empty slot, each lane with its binary node's box; blocks in lane order. The
+    /// same bytes whether the root's children are emitted as tasks (`fork_refs` 1) or not.
+    #[test]
+    fn planned_trees_emit_by_hand() {
+        let boxes = |n: usize| crate::primitives::TestBoxes((0..n).map(|i| Aabb::new(Vec3::splat(i as f32 * 0.01), Vec3::splat(0.5))).collect());
+        let other = |ps: [u32; 4]| ps.map(|p| if p == EMPTY { EMPTY } else { p | TriBlock::OTHER });
+        let bin = vec![BvhNode::interior(aabb(1.0, 1.0, 1.0), 1), BvhNode::leaf(aabb(1.0, 1.0, 1.0), 0, 3), BvhNode::leaf(aabb(1.0, 1.0, 1.0), 3, 3)];
+        let bvh = Bvh::from_parts(bin, (0..6).collect(), 6, "six");
+        for fork_refs in [1, usize::MAX] {
+            let c = collapse_forking::<_, 8>(&bvh, &boxes(6), fork_refs);
+            assert_eq!((c.root, c.nodes.len()), (leaf_ref(0, 2), 0), "one leaf, forking at {fork_refs}");
+            assert_eq!(c.blocks.iter().map(|b| b.prim).collect::<Vec<_>>(), [other([0, 1, 2, 3]), other([4, 5, EMPTY, EMPTY])]);
+        }
+        let (a0, a1, b) = (aabb(0.5, 0.5, 0.75), Aabb::new(Vec3::new(0.5, 0.0, 0.0), Vec3::new(1.0, 0.5, 0.75)), aabb(1.0, 1.0, 0.25));
+        let bin = vec![
+            BvhNode::interior(aabb(1.0, 1.0, 1.0), 1),
+            BvhNode::interior(aabb(1.0, 1.0, 0.75), 3),
+            BvhNode::leaf(b, 0, 4),
+            BvhNode::leaf(a0, 4, 8),
+            BvhNode::leaf(a1, 12, 8),
+        ];
+        let bvh = Bvh::from_parts(bin, (0..20).collect(), 20, "r-a-b");
+        for fork_refs in [1, usize::MAX] {
+            let c = collapse_forking::<_, 4>(&bvh, &boxes(20), fork_refs);
+            assert_eq!((c.root, c.nodes.len(), c.blocks.len()), (0, 1, 5), "forking at {fork_refs}");
+            let n = &c.nodes[0];
+            assert_eq!(n.child, [leaf_ref(0, 2), leaf_ref(2, 2), leaf_ref(4, 1), EMPTY], "forking at {fork_refs}");
+            assert_eq!((n.child_bounds(0), n.child_bounds(1), n.child_bounds(2)), (a0, a1, b));
+            let prims: Vec<[u32; 4]> = c.blocks.iter().map(|b| b.prim).collect();
+            assert_eq!(prims, [other([4, 5, 6, 7]), other([8, 9, 10, 11]), other([12, 13, 14, 15]), other([16, 17, 18, 19]), other([0, 1, 2, 3])]);
+        }
+    }
+
     /// Slots are counted on both sides. R (half area 3, 4 wide) over A (a leaf of four, half
     /// area 1: cost 1) and B (half area 2) over C1 and C2 (half area 1.5 each), each over two
     /// leaves of eight (half area 1, two blocks: 2 each). C whole: 1.5 + 2 + 2 = 5.5; spread
