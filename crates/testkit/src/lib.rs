@@ -25,7 +25,10 @@ pub struct Soup {
 impl Soup {
     pub fn new(prims: Vec<Prim>) -> Self {
         let n = prims.len() as u32;
-        Self { prims, objects: if n > 0 { vec![0..n] } else { vec![] } }
+        // One object holding every primitive.
+        #[allow(clippy::single_range_in_vec_init)]
+        let objects = if n > 0 { vec![0..n] } else { vec![] };
+        Self { prims, objects }
     }
 
     pub fn triangles(tris: impl IntoIterator<Item = [Vec3; 3]>) -> Self {
@@ -158,7 +161,10 @@ pub fn shared_file(name: &str) -> Option<PathBuf> {
 /// Whether every file in `names` is in [`shared_scenes`] (each missing one is reported as by
 /// [`shared_file`]).
 pub fn shared_files(names: &[&str]) -> bool {
-    names.iter().map(|n| shared_file(n).is_some()).fold(true, |a, b| a && b)
+    // Not `all`: it would stop at the first missing file and report only that one.
+    #[allow(clippy::unnecessary_fold)]
+    let all = names.iter().map(|n| shared_file(n).is_some()).fold(true, |a, b| a && b);
+    all
 }
 
 /// A file of the repository's `assets/` folder (always present, unlike the shared data).

@@ -297,6 +297,7 @@ impl Ctx {
         // Bin `⌊clamp((c - lo) · s, 0, nb - 1)⌋ < plane` as one comparison: the plane is a
         // whole number at most `nb - 1`, and a NaN falls in bin 0, on the left.
         let (lo, s, plane_f) = (cb.min[axis], scale[axis], plane as f32);
+        #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x >= p)`, not `x < p`: a NaN goes left.
         let split = partition(refs, |r| !((r.centroid()[axis] - lo) * s >= plane_f), &mut scratch.rights);
         debug_assert!(split.0 > 0 && split.0 < refs.len());
         Some(split)

@@ -55,6 +55,7 @@ impl RayBoxes {
 /// culled by that hit. A NaN slab distance (a ray lying in a slab's plane)
 /// constrains nothing, as in `Aabb::intersect`.
 #[inline(always)]
+#[allow(clippy::needless_range_loop)] // lanes index the bound rows and `tnear` alike
 pub fn boxes_portable<const W: usize>(node: &WideNode<W>, r: &RayBoxes, t_max: f32, tnear: &mut [f32; W]) -> u32 {
     let mut mask = 0;
     for lane in 0..W {

@@ -131,6 +131,7 @@ impl Layout<8> for QuantNode {
 /// The slab test of [`kernels::boxes_portable`](super::kernels::boxes_portable) on the
 /// decoded boxes of the occupied lanes.
 #[inline(always)]
+#[allow(clippy::needless_range_loop)] // lanes index the bound rows and `tnear` alike
 pub fn boxes_portable(n: &QuantNode, r: &RayBoxes, t_max: f32, tnear: &mut [f32; 8]) -> u32 {
     let mut mask = 0;
     for lane in 0..8 {
