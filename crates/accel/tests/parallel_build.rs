@@ -21,7 +21,8 @@ fn builds_do_not_depend_on_the_thread_count() {
     let soup = kit::read_obj_triangles(&path);
     assert!(soup.len() > 65_536);
     let opts = BuildOptions::default();
-    let builders: [(&str, fn(&kit::Soup, &BuildOptions) -> Bvh); 4] = [
+    type Builder = fn(&kit::Soup, &BuildOptions) -> Bvh;
+    let builders: [(&str, Builder); 4] = [
         ("bvh", |s, o| Bvh::build(s, SplitMethod::BinnedSah, o)),
         ("sbvh", |s, o| bvh::sbvh::build(s, o)),
         ("lbvh", |s, o| bvh::lbvh::build(s, o)),
