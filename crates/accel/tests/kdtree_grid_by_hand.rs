@@ -270,7 +270,7 @@ fn grid_is_coarsened_when_bounds_would_overflow_the_reference_budget() {
     let (t, d) = ((2.0f32).powi(-10), (2.0f32).powi(-9));
     let pair = vec![aabb([0.5 + d; 3], [0.5 + 2.0 * d; 3]), aabb([1.0 - t; 3], [1.0; 3])];
     let mut parts = vec![vec![aabb([0.0; 3], [t; 3])]];
-    parts.extend(std::iter::repeat(pair).take(130));
+    parts.extend(std::iter::repeat_n(pair, 130));
     let prims = Parts(parts);
     let g = Grid::build(&prims, &BuildOptions { grid_density: 1e6, ..BuildOptions::default() });
     assert_eq!(g.resolution(), [102, 102, 102]);
