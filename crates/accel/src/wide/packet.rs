@@ -17,7 +17,7 @@ use raylab_core::Ray;
 #[cfg(target_arch = "x86_64")]
 use super::kernels::slabs_avx2;
 use super::kernels::{RayBoxes, ROBUST_FAR};
-use super::node::{is_leaf, ChildRef, Layout, WideNode, EMPTY};
+use super::node::{is_leaf, ChildRef, Layout, TriBlock, WideNode, EMPTY};
 use super::traverse::{block_closest, child_boxes, leaf_slice, occupied, STACK};
 use super::WideBvh;
 use crate::{Counters, Hit, Primitives};
@@ -161,6 +161,20 @@ fn reaching<const SIMD: bool>(t: f32, far: &Far, rays: RayMask) -> RayMask {
 #[repr(C, align(16))]
 struct Far([f32; PACKET]);
 
+/// Starts loading a pushed child: the packet works on its nearer siblings first.
+#[inline(always)]
+fn prefetch<const W: usize, N: Layout<W>>(bvh: &WideBvh<W, N>, r: ChildRef) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        let (p, bytes) = if is_leaf(r) { ((&bvh.blocks[super::node::leaf_blocks(r).0] as *const TriBlock).cast::<i8>(), std::mem::size_of::<TriBlock>()) } else { ((&bvh.nodes[r as usize] as *const N).cast::<i8>(), std::mem::size_of::<N>()) };
+        for line in (0..bytes).step_by(64) {
+            // SAFETY: a prefetch never faults; the lines are those of the element.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(line)) };
+        }
+    }
+}
+
 /// Closest hits of `rays` (at most [`PACKET`]) into `out` (as long as `rays`). The counting
 /// build (`COUNT`) charges each ray the nodes it is active in and the occupied triangle
 /// lanes it tests: a node loaded once for the packet counts once per ray that needed it,
@@ -223,6 +237,7 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
                 if rest & (rest - 1) == 0 {
                     let (first, second) = (any.trailing_zeros() as usize, rest.trailing_zeros() as usize);
                     let (near, far) = if key(second) < key(first) { (second, first) } else { (first, second) };
+                    prefetch(bvh, node.child(far));
                     stack[sp] = MaybeUninit::new(Entry { node: node.child(far), rays: entered[far], t: nearest[far] });
                     sp += 1;
                     cur = node.child(near);
@@ -243,6 +258,7 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
                 }
                 for &key in keys[1..k].iter().rev() {
                     let l = (key & lane_bits) as usize;
+                    prefetch(bvh, node.child(l));
                     stack[sp] = MaybeUninit::new(Entry { node: node.child(l), rays: entered[l], t: nearest[l] });
                     sp += 1;
                 }
