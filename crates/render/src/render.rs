@@ -141,7 +141,9 @@ fn render_pass(scene: &Scene, film: &Film, pass: u32, control: &Control) -> Opti
     let stopped = || control.cancel.load(Ordering::Relaxed) || control.deadline.is_some_and(|d| Instant::now() >= d);
     // Camera rays go in 4×4 packets where the structure traverses them together.
     let packets = scene.accel().has_packets() && scene.settings.integrator.traces_ahead();
-    let done: Vec<Option<(Vec<[f64; CHANNELS]>, Counters, u64)>> = tiles
+    // Per tile, unless stopped: its pixel sums, traversal counters and sample count.
+    type TileSums = Option<(Vec<[f64; CHANNELS]>, Counters, u64)>;
+    let done: Vec<TileSums> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
             if stopped() {

@@ -26,6 +26,8 @@ pub(super) fn cost(scene: &Scene, ray: &Ray, metric: HeatMetric, c: &mut Counter
 }
 
 /// "Turbo"-like ramp (Mikhailov 2019, polynomial fit): dark blue → green → yellow → dark red.
+/// The coefficients are the published fit's, digit for digit.
+#[allow(clippy::excessive_precision)]
 pub fn ramp(x: f32) -> Rgb {
     let x = x.clamp(0.0, 1.0);
     let r = 0.13572138 + x * (4.6153926 + x * (-42.66032258 + x * (132.13108234 + x * (-152.94239396 + x * 59.28637943))));

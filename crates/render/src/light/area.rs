@@ -142,6 +142,7 @@ impl AreaLights {
 
     /// Samples light arriving at `p` from one emitter (`receiver` weighs the `cells`).
     /// `u_choice` picks the emitter, `u` the point on it.
+    #[allow(clippy::too_many_arguments)]
     pub fn sample(&self, geometry: &Geometry, textures: &[Texture], p: Vec3, receiver: Receiver, strategy: LightSampling, u_choice: f32, u: Vec2) -> Option<AreaSample> {
         let k = self.cdf.partition_point(|&c| c <= u_choice).min(self.prims.len().checked_sub(1)?);
         let prim = self.prims[k];
@@ -162,7 +163,9 @@ impl AreaLights {
                     let st = Vec2::new((q - quad.corner).dot(quad.e1) / quad.e1.length_squared(), (q - quad.corner).dot(quad.e2) / quad.e2.length_squared());
                     let dist = (q - p).length();
                     let wi = (q - p) / dist;
-                    if !(dist > 0.0) || quad.normal.dot(-wi) <= 0.0 {
+                    #[allow(clippy::neg_cmp_op_on_partial_ord)] // a NaN distance is no sample either
+                    let behind = !(dist > 0.0) || quad.normal.dot(-wi) <= 0.0;
+                    if behind {
                         return None; // the back of the one-sided light
                     }
                     return Some(AreaSample { wi, dist, le: le_at(st, q), pdf: choice / sr.solid_angle });
@@ -297,6 +300,7 @@ fn find_parallelograms(geometry: &Geometry) -> Vec<Parallelogram> {
 /// The `cells` strategy on one parallelogram: cell weights are the unshadowed light the
 /// point reflects from each cell's centre, `receiver(ω) · max(0, n_l·-ω) / d² · lum(Le)`,
 /// mixed with a uniform share.
+#[allow(clippy::too_many_arguments)]
 fn sample_cells(quad: &Parallelogram, k: u32, p: Vec3, receiver: Receiver, le_at: &dyn Fn(Vec2, Vec3) -> Rgb, choice: f32, u_cell: f32, u: Vec2) -> Option<AreaSample> {
     let k = k as usize;
     let mut storage = [0.0f32; (MAX_CELLS * MAX_CELLS) as usize];
