@@ -204,3 +204,92 @@ fn the_plain_render_of_no_samples_is_black_not_a_panic() {
     let out = crate::render(&scene, &|_| {});
     assert_eq!(out.pixels, vec![Rgb::ZERO; 37 * 21]);
 }
+
+/// FNV-1a, 64 bit, from its definition: offset basis 0xcbf29ce484222325, each byte XORed in,
+/// then multiplied by the prime 2^40 + 2^8 + 0xb3, modulo 2^64.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3))
+}
+
+/// A film file written byte by byte from the layout in `codec.rs`: `header()` (4 × 2, 5 spp in
+/// passes of 1, hashes 1 and 2, version "test", no heat map), the crop 1,1,2,2 (one pixel),
+/// 3 non-finite samples, counters 10, 20, 30, 40, the block count `count`, the blocks
+/// (`first`, `n`) with the pixel's sums (first, n, 0.5, 0.25), and the checksum.
+fn film_file(count: u32, blocks: &[(u32, u32)]) -> Vec<u8> {
+    let mut b = b"RAYLABFM".to_vec();
+    for v in [1u32, 4, 2, 5, 1] {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    b.push(0);
+    b.extend_from_slice(&1u64.to_le_bytes());
+    b.extend_from_slice(&2u64.to_le_bytes());
+    b.extend_from_slice(&[4, 0]);
+    b.extend_from_slice(b"test");
+    for v in [1u32, 1, 2, 2] {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    for v in [3u64, 10, 20, 30, 40] {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    b.extend_from_slice(&count.to_le_bytes());
+    for &(first, n) in blocks {
+        b.extend_from_slice(&first.to_le_bytes());
+        b.extend_from_slice(&n.to_le_bytes());
+        for v in [first as f64, n as f64, 0.5, 0.25] {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    let sum = fnv1a(&b);
+    b.extend_from_slice(&sum.to_le_bytes());
+    b
+}
+
+#[test]
+fn fnv1a_matches_the_published_test_vectors() {
+    // From the FNV reference test suite (Noll): "" is the offset basis, then "a" and "foobar".
+    for (s, want) in [("", 0xcbf2_9ce4_8422_2325u64), ("a", 0xaf63_dc4c_8601_ec8c), ("foobar", 0x8594_4171_f739_67e8)] {
+        let mut h = codec::Fnv64::default();
+        h.update(s.as_bytes());
+        assert_eq!(h.0, want, "{s:?}");
+        let mut w = codec::Fnv64::default();
+        std::fmt::Write::write_str(&mut w, s).unwrap();
+        assert_eq!(w.0, want, "{s:?} through fmt::Write");
+        assert_eq!(fnv1a(s.as_bytes()), want);
+    }
+}
+
+#[test]
+fn film_files_written_by_hand_are_read_and_written_back() {
+    for blocks in [vec![(0, 4), (4, 1)], vec![(0, 2), (2, 1)], vec![(2, 2)], vec![(4, 1)]] {
+        let bytes = film_file(blocks.len() as u32, &blocks);
+        let film = Film::from_bytes(&bytes).unwrap();
+        assert_eq!(film.header, header());
+        assert_eq!(film.crop, Crop { x0: 1, y0: 1, x1: 2, y1: 2 });
+        assert_eq!(film.nonfinite_samples, 3);
+        assert_eq!(film.counters, Counters { rays: 10, nodes_visited: 20, prim_tests: 30, object_tests: 40 });
+        let want: Vec<Block> = blocks.iter().map(|&(first, count)| Block { first, count, sums: vec![first as f64, count as f64, 0.5, 0.25] }).collect();
+        assert_eq!(film.blocks(), &want[..]);
+        assert_eq!(film.to_bytes(), bytes, "{blocks:?}");
+    }
+}
+
+#[test]
+fn film_files_with_bad_sizes_or_blocks_are_refused() {
+    let e = |b: &[u8]| Film::from_bytes(b).unwrap_err().to_string();
+    let not_aligned = |s: &str| format!("not a raylab film: block of passes {s} is not an aligned block following the previous one (of 5 passes)");
+    // Blocks of 3 passes, at an odd start, past the 5 passes, after a gap.
+    assert_eq!(e(&film_file(1, &[(0, 3)])), not_aligned("0+3"));
+    assert_eq!(e(&film_file(1, &[(1, 2)])), not_aligned("1+2"));
+    assert_eq!(e(&film_file(1, &[(4, 2)])), not_aligned("4+2"));
+    assert_eq!(e(&film_file(2, &[(0, 2), (3, 1)])), not_aligned("3+1"));
+    assert_eq!(e(&film_file(2, &[(0, 1), (1, 1)])), "not a raylab film: its blocks are not the maximal blocks of their passes");
+    // 64 blocks is the most a header may announce (then their 64 × 40 bytes must follow).
+    assert_eq!(e(&film_file(64, &[])), "not a raylab film: the header announces 64 blocks of 1 pixels (2560 bytes) but 0 bytes follow");
+    assert_eq!(e(&film_file(65, &[])), "not a raylab film: 65 blocks (at most 64)");
+    // The magic alone is truncated; 20 bytes hold the magic, the format version and a wrong checksum.
+    assert_eq!(e(b"RAYLABFM"), "not a raylab film: truncated (8 bytes)");
+    assert_eq!(e(b"RAYLABFM\x01\x00\x00\x00"), "not a raylab film: truncated (12 bytes)");
+    assert_eq!(e(b"RAYLABFM\x01\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00"), "not a raylab film: checksum mismatch: the file is truncated or damaged");
+    assert_eq!(e(b"RAYLABF"), "not a raylab film: wrong magic bytes (expected RAYLABFM)");
+    assert_eq!(e(b"RAYLABFX\x01\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00"), "not a raylab film: wrong magic bytes (expected RAYLABFM)");
+}
