@@ -465,8 +465,10 @@ fn resolve_and_variance_by_hand() {
     let h = FilmHeader { spp: 3, ..header() };
     let crop = Crop { x0: 0, y0: 0, x1: 2, y1: 1 };
     let mut f = Film::new(h, crop).unwrap();
-    f.add_pass(0, vec![0.0; 8], &Counters::default(), 0).unwrap();
-    assert_eq!(f.variance(), vec![0.0, 0.0]); // one sample: no variance
+    // One sample: no variance, even where the squared luminance (5) is not the square of the
+    // luminance (1), which would divide 5 − 1 by n − 1 = 0.
+    f.add_pass(0, vec![1.0, 1.0, 1.0, 5.0, 0.0, 0.0, 0.0, 0.0], &Counters::default(), 0).unwrap();
+    assert_eq!(f.variance(), vec![0.0, 0.0]);
     let mut f = Film::new(FilmHeader { spp: 3, ..header() }, crop).unwrap();
     for s in 1..=3 {
         let sums: Vec<f64> = (0..2).flat_map(|i| {
