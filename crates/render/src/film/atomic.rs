@@ -92,6 +92,23 @@ mod tests {
     }
 
     #[test]
+    fn the_folder_of_a_bare_name_is_the_current_one() {
+        assert_eq!(parent_dir(Path::new("x.png")), Path::new("."));
+        assert_eq!(parent_dir(Path::new("out/x.png")), Path::new("out"));
+        assert_eq!(parent_dir(Path::new("/x.png")), Path::new("/"));
+        assert_eq!(parent_dir(Path::new("/")), Path::new("."));
+        // A bare name is writable when the current folder is (the tests run in the crate's).
+        assert_eq!(check_writable(Path::new(&format!("raylab-bare-{}.png", std::process::id()))), Ok(()));
+        // Temporary names are hidden, beside the file, and differ from call to call.
+        let (a, b) = (temp_path(Path::new("dir/out.png")), temp_path(Path::new("dir/out.png")));
+        assert_ne!(a, b);
+        for t in [a, b] {
+            assert_eq!(t.parent(), Some(Path::new("dir")));
+            assert!(t.file_name().unwrap().to_str().unwrap().starts_with(".out.png.tmp-"), "{}", t.display());
+        }
+    }
+
+    #[test]
     fn unwritable_destinations_are_named() {
         let missing = std::env::temp_dir().join(format!("raylab-no-such-{}", std::process::id())).join("x.png");
         let e = check_writable(&missing).unwrap_err();

@@ -151,3 +151,89 @@ pub fn metallic_roughness_at(metallic: f32, roughness: f32, texel: Option<Rgb>) 
     let t = texel.unwrap_or(Rgb::ONE);
     ((metallic * t.z).clamp(0.0, 1.0), (roughness * t.y).clamp(0.0, 1.0))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::texture::{Checker, CheckerSpace};
+
+    fn close(a: Rgb, b: Rgb) -> bool {
+        (a - b).abs().max_element() < 1e-6
+    }
+
+    /// Texture 0 a constant, texture 1 a uv checker (white at the origin's cell, black in the next).
+    fn textures() -> Vec<Texture> {
+        let checker = Checker { even: Rgb::ONE, odd: Rgb::ZERO, scale: 2.0, space: CheckerSpace::Uv };
+        vec![Texture::Constant(Rgb::new(0.1, 0.2, 0.3)), Texture::Checker(checker)]
+    }
+
+    #[test]
+    fn tex_colors_are_constants_or_lookups() {
+        let t = textures();
+        let c = Rgb::new(0.7, 0.6, 0.5);
+        assert_eq!(TexColor::from(c), TexColor::Constant(c));
+        assert_eq!(TexColor::Constant(c).eval(&t, Vec2::ZERO, Vec3::ZERO), c);
+        assert_eq!(TexColor::Texture(TextureId(0)).eval(&t, Vec2::ZERO, Vec3::ZERO), Rgb::new(0.1, 0.2, 0.3));
+        assert_eq!(TexColor::Texture(TextureId(1)).eval(&t, Vec2::splat(0.2), Vec3::ZERO), Rgb::ONE);
+        assert_eq!(TexColor::Texture(TextureId(1)).eval(&t, Vec2::new(0.7, 0.2), Vec3::ZERO), Rgb::ZERO);
+    }
+
+    #[test]
+    fn metallic_roughness_scales_by_blue_and_green_and_clamps() {
+        // Blue 0.25 scales metalness 0.5 to 0.125, green 0.5 roughness 0.6 to 0.3; red is ignored.
+        assert_eq!(metallic_roughness_at(0.5, 0.6, Some(Rgb::new(0.9, 0.5, 0.25))), (0.125, 0.3));
+        assert_eq!(metallic_roughness_at(0.5, 0.6, None), (0.5, 0.6));
+        assert_eq!(metallic_roughness_at(2.0, 3.0, Some(Rgb::new(0.0, 0.5, 0.75))), (1.0, 1.0));
+        assert_eq!(metallic_roughness_at(-0.5, -1.0, None), (0.0, 0.0));
+    }
+
+    #[test]
+    fn metallic_roughness_bsdf_by_hand() {
+        let t = textures();
+        // Base (0.8, 0.4, 0.2); metalness 0.5 × blue 0.5 = 0.25; roughness 0.6 × green 0.5 = 0.3.
+        let t = [t, vec![Texture::Constant(Rgb::new(0.0, 0.5, 0.5))]].concat();
+        let m = Material::MetallicRoughness { base_color: Rgb::new(0.8, 0.4, 0.2).into(), metallic: 0.5, roughness: 0.6, metallic_roughness: Some(TextureId(2)) };
+        let Bsdf::CookTorrance { diffuse, specular, alpha, distribution, geometry, fresnel: Fresnel::Schlick(f0) } = m.bsdf(&t, Vec2::ZERO, Vec3::ZERO) else { panic!() };
+        // Diffuse b·(1 − m) = 0.75 b; α = r² = 0.09; f0 = 0.04 + 0.25·(b − 0.04).
+        assert!(close(diffuse, Rgb::new(0.6, 0.3, 0.15)), "{diffuse}");
+        assert_eq!(specular, Rgb::ONE);
+        assert!((alpha - 0.09).abs() < 1e-7, "{alpha}");
+        assert_eq!((distribution, geometry), (Distribution::Ggx, MicrofacetGeometry::Smith));
+        assert!(close(f0, Rgb::new(0.23, 0.13, 0.08)), "{f0}");
+        assert_eq!(m.albedo(&t, Vec2::ZERO, Vec3::ZERO), Rgb::new(0.8, 0.4, 0.2));
+        // Roughness 0 is held at α = 10⁻³; full metal has no diffuse and f0 = b.
+        let m = Material::MetallicRoughness { base_color: Rgb::new(0.8, 0.4, 0.2).into(), metallic: 1.0, roughness: 0.0, metallic_roughness: None };
+        let Bsdf::CookTorrance { diffuse, alpha, fresnel: Fresnel::Schlick(f0), .. } = m.bsdf(&t, Vec2::ZERO, Vec3::ZERO) else { panic!() };
+        assert_eq!((diffuse, alpha), (Rgb::ZERO, MIN_ALPHA));
+        assert!(close(f0, Rgb::new(0.8, 0.4, 0.2)), "{f0}");
+    }
+
+    #[test]
+    fn every_material_maps_to_its_bsdf_and_albedo() {
+        let t = textures();
+        let (uv, p) = (Vec2::new(0.7, 0.2), Vec3::ZERO); // the checker's black cell
+        let tex = TexColor::Texture(TextureId(1));
+        let (a, b) = (Rgb::new(0.1, 0.2, 0.3), Rgb::new(0.4, 0.5, 0.6));
+        let at = |m: &Material| (m.bsdf(&t, uv, p), m.albedo(&t, uv, p), m.type_name());
+        assert_eq!(at(&Material::Diffuse { albedo: a.into() }), (Bsdf::Lambert { albedo: a }, a, "diffuse"));
+        assert_eq!(at(&Material::Diffuse { albedo: tex }), (Bsdf::Lambert { albedo: Rgb::ZERO }, Rgb::ZERO, "diffuse"));
+        assert_eq!(at(&Material::Phong { ka: Rgb::ONE.into(), kd: a.into(), ks: b.into(), exponent: 20.0 }), (Bsdf::Phong { kd: a, ks: b, exponent: 20.0 }, a, "phong"));
+        assert_eq!(at(&Material::Mirror { reflectance: b.into() }), (Bsdf::Mirror { reflectance: b }, b, "mirror"));
+        assert_eq!(at(&Material::Dielectric { ior: 1.5 }), (Bsdf::Dielectric { ior: 1.5 }, Rgb::ONE, "dielectric"));
+        let ct = Material::CookTorrance { diffuse: a.into(), specular: b.into(), roughness: 0.2, distribution: Distribution::Beckmann, geometry: MicrofacetGeometry::Smith, f0: Rgb::splat(0.04).into() };
+        let want = Bsdf::CookTorrance { diffuse: a, specular: b, alpha: 0.2, distribution: Distribution::Beckmann, geometry: MicrofacetGeometry::Smith, fresnel: Fresnel::Schlick(Rgb::splat(0.04)) };
+        // The albedo AOV of Cook–Torrance is diffuse + specular: (0.5, 0.7, 0.9).
+        let (bsdf, albedo, name) = at(&ct);
+        assert_eq!((bsdf, name), (want, "cooktorrance"));
+        assert!(close(albedo, Rgb::new(0.5, 0.7, 0.9)), "{albedo}");
+        // Gold: the albedo is the reflectance at normal incidence ((η − 1)² + k²) / ((η + 1)² + k²).
+        let (eta, k) = (Rgb::new(0.143, 0.374, 1.442), Rgb::new(3.983, 2.385, 1.603));
+        let (bsdf, albedo, name) = at(&Material::Conductor { eta, k, roughness: 0.3, distribution: Distribution::Ggx, geometry: MicrofacetGeometry::Smith });
+        assert_eq!((bsdf, name), (Bsdf::CookTorrance { diffuse: Rgb::ZERO, specular: Rgb::ONE, alpha: 0.3, distribution: Distribution::Ggx, geometry: MicrofacetGeometry::Smith, fresnel: Fresnel::Conductor { eta, k } }, "conductor"));
+        assert!((albedo - Rgb::new(0.966688, 0.802537, 0.324034)).abs().max_element() < 1e-5, "{albedo}");
+        assert_eq!(at(&Material::Hair { color: a.into(), kd: 0.6, ks: 0.4, exponent: 30.0 }), (Bsdf::KajiyaKay { color: a, kd: 0.6, ks: 0.4, exponent: 30.0 }, a, "hair"));
+        let mr = Material::MetallicRoughness { base_color: a.into(), metallic: 0.0, roughness: 1.0, metallic_roughness: None };
+        assert_eq!((at(&mr).1, at(&mr).2), (a, "metallic-roughness"));
+        assert_eq!(Material::default_diffuse(), Material::Diffuse { albedo: TexColor::Constant(Rgb::splat(0.5)) });
+    }
+}

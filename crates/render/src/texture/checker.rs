@@ -97,6 +97,36 @@ mod tests {
     }
 
     #[test]
+    fn solid_cells_are_one_over_scale_wide_on_every_axis() {
+        // Scale 2: cells 0.5 wide. 0.3 is in cell 0 and 0.6 in cell 1 along each axis; with
+        // `p * s` read as `p / s` (0.15, 0.3) or `p + s` (2.3, 2.6) both would be in one cell.
+        let c = board(2.0, CheckerSpace::Solid);
+        let at = |x, y, z| c.eval(Vec2::splat(0.7), Vec3::new(x, y, z));
+        assert_eq!(at(0.3, 0.3, 0.3), E); // cell (0, 0, 0)
+        assert_eq!(at(0.6, 0.3, 0.3), O); // cell (1, 0, 0)
+        assert_eq!(at(0.3, 0.6, 0.3), O); // cell (0, 1, 0)
+        assert_eq!(at(0.3, 0.3, 0.6), O); // cell (0, 0, 1)
+        assert_eq!(at(0.6, 0.6, 0.3), E); // cell (1, 1, 0): 2 is even
+        assert_eq!(at(0.6, 0.3, 0.6), E); // cell (1, 0, 1)
+        assert_eq!(at(0.3, 0.6, 0.6), E); // cell (0, 1, 1)
+        assert_eq!(at(0.6, 0.6, 0.6), O); // cell (1, 1, 1): 3 is odd
+        assert_eq!(at(1.1, 0.3, 0.3), E); // cell (2, 0, 0)
+        assert_eq!(at(-0.3, 0.3, 0.3), O); // cell (-1, 0, 0)
+        // Scale 0.5: cells 2 wide, so 1.5 is still cell 0 and 2.5 cell 1.
+        let c = board(0.5, CheckerSpace::Solid);
+        let at = |x, y, z| c.eval(Vec2::splat(0.7), Vec3::new(x, y, z));
+        assert_eq!(at(1.5, 1.5, 1.5), E);
+        assert_eq!(at(2.5, 1.5, 1.5), O);
+        assert_eq!(at(1.5, 1.5, 2.5), O);
+        // A uv board ignores p: the same uv gives the same colour anywhere in space.
+        let c = board(2.0, CheckerSpace::Uv);
+        assert_eq!(c.eval(Vec2::new(0.6, 0.3), Vec3::splat(0.3)), O);
+        assert_eq!(c.eval(Vec2::new(0.6, 0.3), Vec3::new(0.6, 5.3, -2.4)), O);
+        assert_eq!(c.eval(Vec2::new(0.6, 0.6), Vec3::splat(0.3)), E);
+        assert_eq!(c.eval(Vec2::new(0.3, 0.6), Vec3::splat(0.3)), O); // cell (0, 1)
+    }
+
+    #[test]
     fn names_parse() {
         assert_eq!("solid".parse(), Ok(CheckerSpace::Solid));
         assert_eq!("uv".parse(), Ok(CheckerSpace::Uv));

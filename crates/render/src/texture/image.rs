@@ -277,6 +277,88 @@ mod tests {
         assert_close(t.average(), Rgb::new(0.5, 0.5, 0.0));
     }
 
+    /// A 3 × 2 image of greys: row 0 (top) 0, 1, 2; row 1 (bottom) 10, 20, 40.
+    fn grey_3x2(wrap: Wrap, filter: Filter) -> ImageTexture {
+        let texels = [0.0, 1.0, 2.0, 10.0, 20.0, 40.0].map(Rgb::splat).to_vec();
+        ImageTexture::new(3, 2, texels, wrap, filter).unwrap()
+    }
+
+    fn assert_grey(got: Rgb, want: f32) {
+        assert!((got - Rgb::splat(want)).abs().max_element() < 1e-4, "got {got}, want {want}");
+    }
+
+    #[test]
+    fn wrap_modes_on_three_texels_by_hand() {
+        // Texel column i of a 3-wide image is read at u = (i + ½) / 3. Repeat has period 3,
+        // clamp holds the ends, mirror has period 6: 0 1 2 2 1 0.
+        let texels = [5.0, 6.0, 7.0].map(Rgb::splat).to_vec();
+        let row = |wrap| ImageTexture::new(3, 1, texels.clone(), wrap, Filter::Nearest).unwrap();
+        let column = |wrap| ImageTexture::new(1, 3, texels.clone(), wrap, Filter::Nearest).unwrap();
+        let cases: [(i32, [usize; 3]); 12] = [
+            // (texel index, [repeat, clamp, mirror])
+            (-6, [0, 0, 0]),
+            (-5, [1, 0, 1]),
+            (-4, [2, 0, 2]),
+            (-3, [0, 0, 2]),
+            (-2, [1, 0, 1]),
+            (-1, [2, 0, 0]),
+            (0, [0, 0, 0]),
+            (2, [2, 2, 2]),
+            (3, [0, 2, 2]),
+            (4, [1, 2, 1]),
+            (5, [2, 2, 0]),
+            (7, [1, 2, 1]),
+        ];
+        for (i, want) in cases {
+            let c = (i as f32 + 0.5) / 3.0;
+            for (wrap, w) in [Wrap::Repeat, Wrap::Clamp, Wrap::Mirror].into_iter().zip(want) {
+                assert_eq!(row(wrap).lookup(Vec2::new(c, 0.5)), Rgb::splat(5.0 + w as f32), "{wrap} column {i}");
+                // Rows count down from the top: row i is at v = 1 − (i + ½) / 3.
+                assert_eq!(column(wrap).lookup(Vec2::new(0.5, 1.0 - c)), Rgb::splat(5.0 + w as f32), "{wrap} row {i}");
+            }
+        }
+    }
+
+    #[test]
+    fn nearest_on_a_wider_than_tall_image() {
+        let t = grey_3x2(Wrap::Clamp, Filter::Nearest);
+        assert_eq!((t.width(), t.height()), (3, 2));
+        assert_eq!(t.texels(), &[0.0, 1.0, 2.0, 10.0, 20.0, 40.0].map(Rgb::splat)[..]);
+        // u = 0.5 is column 1 (x = 1.5), v = 0.3 the bottom row (y = 1.4), v = 0.7 the top (y = 0.6).
+        assert_grey(t.lookup(Vec2::new(0.5, 0.3)), 20.0);
+        assert_grey(t.lookup(Vec2::new(0.5, 0.7)), 1.0);
+        assert_grey(t.lookup(Vec2::new(0.9, 0.7)), 2.0);
+        assert_grey(t.lookup(Vec2::new(0.1, 0.3)), 10.0);
+    }
+
+    #[test]
+    fn bilinear_on_a_wider_than_tall_image_by_hand() {
+        // u = 0.6: x = 1.8, x − ½ = 1.3, columns 1 and 2 at 0.3. v = 0.55: y = 0.9, y − ½ = 0.4,
+        // rows 0 and 1 at 0.4. Top 1 + 0.3·(2 − 1) = 1.3, bottom 20 + 0.3·(40 − 20) = 26,
+        // 1.3 + 0.4·(26 − 1.3) = 11.18 in every wrap mode (all four texels inside).
+        for &wrap in Wrap::ALL {
+            assert_grey(grey_3x2(wrap, Filter::Bilinear).lookup(Vec2::new(0.6, 0.55)), 11.18);
+        }
+        // u = 0.1: x − ½ = −0.2, columns −1 and 0 at 0.8. Repeat reads column −1 as 2:
+        // top 2 + 0.8·(0 − 2) = 0.4, bottom 40 + 0.8·(10 − 40) = 16, 0.4 + 0.4·15.6 = 6.64.
+        // Clamp and mirror read it as 0: top 0, bottom 10, 0.4·10 = 4.
+        let at = |wrap, u, v| grey_3x2(wrap, Filter::Bilinear).lookup(Vec2::new(u, v));
+        assert_grey(at(Wrap::Repeat, 0.1, 0.55), 6.64);
+        assert_grey(at(Wrap::Clamp, 0.1, 0.55), 4.0);
+        assert_grey(at(Wrap::Mirror, 0.1, 0.55), 4.0);
+        // v = 0.1: y − ½ = 1.3, rows 1 and 2 at 0.3. Repeat reads row 2 as row 0:
+        // 26 + 0.3·(1.3 − 26) = 18.59; clamp and mirror read it as row 1: 26.
+        assert_grey(at(Wrap::Repeat, 0.6, 0.1), 18.59);
+        assert_grey(at(Wrap::Clamp, 0.6, 0.1), 26.0);
+        assert_grey(at(Wrap::Mirror, 0.6, 0.1), 26.0);
+        // Tiled by (2, 3): uv (0.3, 0.85) reads (0.6, 2.55), which repeats (0.6, 0.55).
+        let mut t = grey_3x2(Wrap::Repeat, Filter::Bilinear);
+        t.scale = Vec2::new(2.0, 3.0);
+        assert_grey(t.lookup(Vec2::new(0.3, 0.85)), 11.18);
+        // Average (0 + 1 + 2 + 10 + 20 + 40) / 6 = 73/6.
+        assert_grey(t.average(), 73.0 / 6.0);
+    }
+
     #[test]
     fn names_parse_and_errors_list_them() {
         for &w in Wrap::ALL {
