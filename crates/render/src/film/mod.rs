@@ -121,7 +121,7 @@ impl FilmHeader {
         if k == 0 {
             return Err(FilmError::Invalid("the pass size must be at least 1 sample".into()));
         }
-        let aligned = |s: u32| s % k == 0 || s == self.spp;
+        let aligned = |s: u32| s.is_multiple_of(k) || s == self.spp;
         if samples.start >= samples.end || samples.end > self.spp || !aligned(samples.start) || !aligned(samples.end) {
             return Err(FilmError::Invalid(format!(
                 "samples {}..{} must be a non-empty range within 0..{} starting and ending on a multiple of the pass size {k}",
@@ -174,7 +174,7 @@ impl Block {
     }
     /// Whether `next` is this block's right sibling in the pass tree.
     fn is_left_sibling_of(&self, next: &Block) -> bool {
-        self.count == next.count && self.first % (2 * self.count) == 0 && next.first == self.end()
+        self.count == next.count && self.first.is_multiple_of(2 * self.count) && next.first == self.end()
     }
 }
 

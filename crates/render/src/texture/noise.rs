@@ -54,7 +54,7 @@ impl Noise {
     pub fn new(kind: NoiseKind, scale: f32, colors: [Rgb; 2], octaves: u32, seed: u64) -> Self {
         let mut p: [u8; 256] = std::array::from_fn(|i| i as u8);
         // Fisher-Yates with an unbiased bounded draw.
-        let mut rng = Pcg32::new(seed, 0x6e6f_6973_65); // stream "noise", apart from pixel streams
+        let mut rng = Pcg32::new(seed, 0x6e_6f_69_73_65); // stream "noise" (its ASCII bytes), apart from pixel streams
         for i in (1..256u32).rev() {
             let j = rng.below(i + 1);
             p.swap(i as usize, j as usize);
