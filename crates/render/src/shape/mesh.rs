@@ -371,6 +371,43 @@ mod tests {
         assert!((mesh.normals[2] - left).length() < 1e-6, "{}", mesh.normals[2]);
     }
 
+    /// -0 and +0 are one position: the roof's ridge copies at x = -0 and x = +0 weld, and
+    /// get the two faces' average, straight up.
+    #[test]
+    fn smooth_normals_weld_minus_zero_with_zero() {
+        let mut mesh = TriangleMesh {
+            positions: vec![
+                Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 1.0), Vec3::new(-1.0, 0.0, 0.0),
+                Vec3::new(-0.0, 1.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(-0.0, 1.0, 1.0),
+            ],
+            indices: vec![[0, 2, 1], [3, 5, 4]],
+            ..Default::default()
+        };
+        mesh.compute_smooth_normals(180.0);
+        for i in [0, 1, 3, 5] {
+            assert!((mesh.normals[i] - Vec3::Y).length() < 1e-6, "{i}: {}", mesh.normals[i]);
+        }
+    }
+
+    /// Coplanar faces join even under a crease angle of 0 (the slack of 10⁻⁶ in the cosine),
+    /// whatever the rounding of their normals: a fan of four triangles around (0.3, 0.7, 0)
+    /// in z = 0 keeps one normal, +z, per vertex, and no vertex is split; a copy of a vertex
+    /// that no triangle uses takes the normal at its position.
+    #[test]
+    fn coplanar_faces_join_at_a_crease_angle_of_zero() {
+        let mut mesh = TriangleMesh {
+            positions: vec![Vec3::new(0.3, 0.7, 0.0), Vec3::ZERO, Vec3::new(1.1, 0.0, 0.0), Vec3::new(1.1, 1.3, 0.0), Vec3::new(0.0, 1.3, 0.0), Vec3::new(1.1, 1.3, 0.0)],
+            indices: vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]],
+            uvs: vec![Vec2::ZERO; 6],
+            ..Default::default()
+        };
+        mesh.compute_smooth_normals(0.0);
+        assert_eq!((mesh.positions.len(), mesh.uvs.len()), (6, 6));
+        for (i, n) in mesh.normals.iter().enumerate() {
+            assert!((*n - Vec3::Z).length() < 1e-6, "{i}: {n}");
+        }
+    }
+
     #[test]
     fn roof_ridge_is_creased_only_beyond_the_crease_angle() {
         // The roof's faces are 90° apart.
