@@ -252,7 +252,7 @@ mod tests {
     /// so ∂p/∂u = -x̂ (pbrt-v4 §6.5.3: det = -1, ∂p/∂u = (d2.y·e1 - d1.y·e2)/det), ∂p/∂v = ŷ.
     /// A unit sphere at (10, 0, 2.5) stretched by 2 in z (the ellipsoid around (10, 0, 5)
     /// with semi-axes 1, 1, 2). A strand of two straight segments of radius 0.1 along x at
-    /// z = -5.
+    /// z = -5. A flat bicubic patch over the unit square at z = -10.
     fn scene() -> Geometry {
         let mut g = Geometry::default();
         g.add_mesh(TriangleMesh {
@@ -268,22 +268,24 @@ mod tests {
         g.add_sphere(Sphere { center: Vec3::new(10.0, 0.0, 2.5), radius: 1.0, to_world: Transform::scale(Vec3::new(1.0, 1.0, 2.0)).unwrap(), material: MaterialId(4), emission: Rgb::new(0.5, 0.25, 0.125) });
         let cp = |x: f32| glam::Vec4::new(x, 0.0, -5.0, 0.1);
         g.add_curve(Curve::new(vec![curve::Bezier::new(&[cp(0.0), cp(1.0)]).unwrap(), curve::Bezier::new(&[cp(1.0), cp(2.0)]).unwrap()], MaterialId(5)));
+        let points = std::array::from_fn(|k| Vec3::new((k % 4) as f32 / 3.0, (k / 4) as f32 / 3.0, -10.0));
+        g.add_patches(PatchSurfaces::new(vec![BezierPatch { points }], 2, MaterialId(6)));
         g
     }
 
     #[test]
     fn each_shape_is_one_object_of_consecutive_primitives() {
         let g = scene();
-        assert_eq!(Primitives::len(&g), 5);
+        assert_eq!(Primitives::len(&g), 6);
         assert_eq!(g.triangle_count(), 2);
-        let prims: Vec<PrimRef> = (0..5).map(|i| g.prim(i)).collect();
-        assert_eq!(prims, [PrimRef::Triangle { mesh: 0, tri: 0 }, PrimRef::Triangle { mesh: 0, tri: 1 }, PrimRef::Sphere(0), PrimRef::Curve { curve: 0, seg: 0 }, PrimRef::Curve { curve: 0, seg: 1 }]);
-        assert_eq!(g.objects(), [0..2, 2..3, 3..5]);
-        assert_eq!((0..5).map(|i| g.material(i).0).collect::<Vec<_>>(), [3, 3, 4, 5, 5]);
-        assert_eq!((0..5).map(|i| g.emission(i)).collect::<Vec<_>>(), [Rgb::new(1.0, 2.0, 3.0), Rgb::new(1.0, 2.0, 3.0), Rgb::new(0.5, 0.25, 0.125), Rgb::ZERO, Rgb::ZERO]);
-        assert_eq!((0..5).map(|i| g.emission_texture(i)).collect::<Vec<_>>(), [Some(TextureId(7)), Some(TextureId(7)), None, None, None]);
+        let prims: Vec<PrimRef> = (0..6).map(|i| g.prim(i)).collect();
+        assert_eq!(prims, [PrimRef::Triangle { mesh: 0, tri: 0 }, PrimRef::Triangle { mesh: 0, tri: 1 }, PrimRef::Sphere(0), PrimRef::Curve { curve: 0, seg: 0 }, PrimRef::Curve { curve: 0, seg: 1 }, PrimRef::Patch { set: 0, patch: 0 }]);
+        assert_eq!(g.objects(), [0..2, 2..3, 3..5, 5..6]);
+        assert_eq!((0..6).map(|i| g.material(i).0).collect::<Vec<_>>(), [3, 3, 4, 5, 5, 6]);
+        assert_eq!((0..6).map(|i| g.emission(i)).collect::<Vec<_>>(), [Rgb::new(1.0, 2.0, 3.0), Rgb::new(1.0, 2.0, 3.0), Rgb::new(0.5, 0.25, 0.125), Rgb::ZERO, Rgb::ZERO, Rgb::ZERO]);
+        assert_eq!((0..6).map(|i| g.emission_texture(i)).collect::<Vec<_>>(), [Some(TextureId(7)), Some(TextureId(7)), None, None, None, None]);
         assert_eq!(g.triangle(1), Some([Vec3::new(2.0, 0.0, 0.0), Vec3::new(3.0, 0.0, 0.0), Vec3::new(2.0, 1.0, 0.0)]));
-        assert_eq!((g.triangle(2), g.triangle(3)), (None, None));
+        assert_eq!((g.triangle(2), g.triangle(3), g.triangle(5)), (None, None, None));
     }
 
     #[test]
@@ -299,7 +301,7 @@ mod tests {
             assert!(lo.cmple(tube_lo).all() && hi.cmpge(tube_hi).all() && (lo - tube_lo).max_element().abs() < 1e-3 && (hi - tube_hi).max_element() < 1e-3, "{lo} {hi}");
         }
         let (lo, hi) = b(g.total_bounds());
-        assert!((lo - Vec3::new(-0.1, -1.0, -5.1)).abs().max_element() < 1e-3 && (hi - Vec3::new(11.0, 1.0, 7.0)).abs().max_element() < 1e-3, "{lo} {hi}");
+        assert!((lo - Vec3::new(-0.1, -1.0, -10.0)).abs().max_element() < 1e-3 && (hi - Vec3::new(11.0, 1.0, 7.0)).abs().max_element() < 1e-3, "{lo} {hi}");
         // Triangle 0 cut by x, y ≤ ½ keeps the square's corner (½, ½) inside... the clipped
         // polygon (0,0) (½,0) (½,½) (0,½); the sphere keeps its box ∩ the clip box.
         let clip = Aabb::new(Vec3::splat(-1.0), Vec3::new(0.5, 0.5, 4.0));
@@ -349,6 +351,12 @@ mod tests {
         assert!((h.t - 4.9).abs() < 1e-3, "{}", h.t);
         let s = g.surface(&ray, 4, h.t, h.u, h.v);
         assert!((s.p - Vec3::new(1.5, 0.0, -4.9)).length() < 1e-3 && (s.ng - Vec3::Z).length() < 1e-2, "{} {}", s.p, s.ng);
+        // The patch from (0.25, 0.5, 0) down: t = 10.
+        let ray = Ray::new(Vec3::new(0.25, 0.5, 0.0), -Vec3::Z);
+        let h = g.intersect(5, &ray).unwrap();
+        assert!((h.t - 10.0).abs() < 1e-5, "{}", h.t);
+        let s = g.surface(&ray, 5, h.t, h.u, h.v);
+        assert!((s.p - Vec3::new(0.25, 0.5, -10.0)).length() < 1e-5 && s.ng.z.abs() > 0.999, "{} {}", s.p, s.ng);
     }
 
     #[test]
