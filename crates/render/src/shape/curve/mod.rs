@@ -145,6 +145,17 @@ mod tests {
         let ray = Ray::new(Vec3::new(-0.3, 0.0, 3.0), -Vec3::Z);
         let h = c.intersect(0, &ray).unwrap();
         assert!((h.t - 2.6).abs() < 1e-4 && h.u == 0.0, "{h:?}");
+        // From inside, on the axis at x = 0.9, along +x: the sphere closing segment 0 at the
+        // joint (centre x = 1) is left at x = 1.5, inside segment 1's tube: interior, no
+        // hit. Segment 1's round end is left at x = 2.5, t = 1.6. The same backwards.
+        let ray = Ray::new(Vec3::new(0.9, 0.0, 0.0), Vec3::X);
+        assert_eq!(c.intersect(0, &ray), None);
+        let h = c.intersect(1, &ray).unwrap();
+        assert!((h.t - 1.6).abs() < 1e-4 && (h.u - 1.0).abs() < 1e-6, "{h:?}");
+        let ray = Ray::new(Vec3::new(1.1, 0.0, 0.0), -Vec3::X);
+        assert_eq!(c.intersect(1, &ray), None);
+        let h = c.intersect(0, &ray).unwrap();
+        assert!((h.t - 1.6).abs() < 1e-4 && h.u.abs() < 1e-6, "{h:?}");
     }
 
     /// The surface at hits given by hand (the point is o + t·d): the normal is the offset from
