@@ -165,10 +165,10 @@ mod tests {
     #[test]
     fn surface_by_hand() {
         let c = strand();
-        // Seg 1 at u = ½ (centre (1.5, 0, 0)), the point (1.6, 0, 0.5) from z = 3 down: offset
-        // (0.1, 0, 0.5), less its x part: n = ẑ.
-        let ray = Ray::new(Vec3::new(1.6, 0.0, 3.0), -Vec3::Z);
-        let g = c.surface(1, &ray, 2.5, 0.5, 0.25);
+        // Seg 1 at u = ½ (centre (1.5, 0, 0)), the point (1.6, 0, 0.5) from z = 3 down (a
+        // direction of length 2, t = 1.25): offset (0.1, 0, 0.5), less its x part: n = ẑ.
+        let ray = Ray::new(Vec3::new(1.6, 0.0, 3.0), Vec3::new(0.0, 0.0, -2.0));
+        let g = c.surface(1, &ray, 1.25, 0.5, 0.25);
         assert_eq!((g.p, g.ng, g.ns, g.uv), (Vec3::new(1.6, 0.0, 0.5), Vec3::Z, Vec3::Z, Vec2::new(0.75, 0.25)));
         assert_eq!((g.dpdu, g.dpdv), (Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)));
         // γ₆₄·(|o| + |t·d| + |p|, largest coordinates 3 + 2.5 + 1.6) + 10⁻⁴·r
@@ -189,13 +189,14 @@ mod tests {
     }
 
     /// A quadratic whose first two control points coincide has no tangent at u = 0: the
-    /// chord's direction stands in (here x̂, so the x part of the offset is dropped).
+    /// chord's direction stands in, p(1) - p(0) = (1, 2, 0) - (1, 0, 0) along ŷ, so the y
+    /// part of the offset is dropped.
     #[test]
     fn surface_where_the_tangent_vanishes_uses_the_chord() {
-        let cp = |x: f32| Vec4::new(x, 0.0, 0.0, 0.5);
+        let cp = |y: f32| Vec4::new(1.0, y, 0.0, 0.5);
         let c = Curve::new(vec![Bezier::new(&[cp(-1.0), cp(0.0)]).unwrap(), Bezier::new(&[cp(0.0), cp(0.0), cp(2.0)]).unwrap()], MaterialId(0));
-        let g = c.surface(1, &Ray::new(Vec3::new(0.3, 0.0, 3.0), -Vec3::Z), 2.6, 0.0, 0.5);
-        // ∂p/∂v = ẑ × x̂ · 2r
-        assert_eq!((g.ng, g.dpdu, g.dpdv), (Vec3::Z, Vec3::ZERO, Vec3::Y));
+        let g = c.surface(1, &Ray::new(Vec3::new(1.0, 0.3, 3.0), -Vec3::Z), 2.6, 0.0, 0.5);
+        // ∂p/∂v = ẑ × ŷ · 2r
+        assert_eq!((g.ng, g.dpdu, g.dpdv), (Vec3::Z, Vec3::ZERO, -Vec3::X));
     }
 }
