@@ -324,11 +324,13 @@ mod tests {
     /// x̂ on A = O (1,0,0) (0,1,0) (uv = (x, y): ∂p/∂v = ŷ), and ŷ on B = O (0,-1,0) (1,-1,0)
     /// (uv = (y, -x): ∂p/∂v = -x̂). A's corner at O is 90°, B's 45°, so O's tangent is
     /// (π/2·x̂ + π/4·ŷ) normalised, (2, 1, 0)/√5; its sign +1 (ẑ × t along π/2·ŷ - π/4·x̂).
-    /// A's other corners take A's frame alone (x̂, +1); B's (ŷ, +1).
+    /// A's other corners take A's frame alone (x̂, +1); B's (ŷ, +1). The whole is then moved
+    /// by (0.5, -2, 3) (no vertex at the origin), which changes none of that.
     #[test]
     fn tangents_are_angle_weighted_and_orthogonal_to_the_normal() {
-        let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, -Vec3::Y, Vec3::new(1.0, -1.0, 0.0)];
+        let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, -Vec3::Y, Vec3::new(1.0, -1.0, 0.0)];
         let uvs = positions.iter().map(|p| if p.y < 0.0 { Vec2::new(p.y, -p.x) } else { Vec2::new(p.x, p.y) }).collect();
+        let positions = positions.iter().map(|p| *p + Vec3::new(0.5, -2.0, 3.0)).collect();
         let mut m = TriangleMesh { positions, uvs, indices: vec![[0, 1, 2], [0, 3, 4]], ..Default::default() };
         m.compute_tangents();
         let t = |m: &TriangleMesh, i: usize| (m.tangents[i].truncate(), m.tangents[i].w);
@@ -343,7 +345,7 @@ mod tests {
         assert!(close(t(&m, 1).0, Vec3::new(0.8, 0.0, -0.6)) && t(&m, 1).1 == 1.0, "{:?}", t(&m, 1));
         // UVs mirrored in u (uv = (-x, y) on A alone): ∂p/∂u = -x̂, and ẑ × (-x̂) = -ŷ is
         // against ∂p/∂v = ŷ: sign -1.
-        let mut a = TriangleMesh { positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y], uvs: vec![Vec2::ZERO, -Vec2::X, Vec2::Y], indices: vec![[0, 1, 2]], ..Default::default() };
+        let mut a = TriangleMesh { positions: vec![Vec3::ONE, Vec3::new(2.0, 1.0, 1.0), Vec3::new(1.0, 2.0, 1.0)], uvs: vec![Vec2::ZERO, -Vec2::X, Vec2::Y], indices: vec![[0, 1, 2]], ..Default::default() };
         a.compute_tangents();
         for v in &a.tangents {
             assert!(close(v.truncate(), -Vec3::X) && v.w == -1.0, "{v}");
