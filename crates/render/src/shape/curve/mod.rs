@@ -141,6 +141,11 @@ mod tests {
         assert!(c.intersect(0, &ray).is_none());
         let h = c.intersect(1, &ray).unwrap();
         assert!((h.t - 2.5).abs() < 1e-4 && (h.u - 0.5).abs() < 1e-4 && (h.v - 0.5).abs() < 1e-3, "{h:?}");
+        // Off the axis by ±¼ of the radius ½ (y = ±0.25, hits at z = √(¼ - 1/16)): v is ½ ± ¼,
+        // one on each side.
+        let [a, b] = [0.25f32, -0.25].map(|y| c.intersect(1, &Ray::new(Vec3::new(1.5, y, 3.0), -Vec3::Z)).unwrap());
+        assert!((a.t - (3.0 - 0.1875f32.sqrt())).abs() < 1e-4 && (b.t - a.t).abs() < 1e-5, "{a:?} {b:?}");
+        assert!(((a.v - 0.5).abs() - 0.25).abs() < 1e-3 && (a.v + b.v - 1.0).abs() < 1e-3, "{a:?} {b:?}");
         // Past the first segment's round end x = 0: the end sphere, at x = -0.3, z = 0.4.
         let ray = Ray::new(Vec3::new(-0.3, 0.0, 3.0), -Vec3::Z);
         let h = c.intersect(0, &ray).unwrap();
