@@ -279,6 +279,8 @@ mod tests {
     fn radius_bounds_and_transform_by_hand() {
         let q = Bezier::new(&[Vec4::new(1.0, 1.0, 1.0, 0.3), Vec4::new(2.0, -1.0, 0.0, 0.7), Vec4::new(0.0, 0.0, 3.0, 0.2)]).unwrap();
         assert_eq!(q.max_radius(), 0.7);
+        // At u = ½: ¼·0.3 + ½·0.7 + ¼·0.2.
+        assert!((q.radius(0.5) - 0.475).abs() < 1e-6, "{}", q.radius(0.5));
         // The hull (0, -1, 0)–(2, 1, 3) grown by 0.7.
         let b = q.bounds();
         assert!(close(b.min.extend(0.0), Vec4::new(-0.7, -1.7, -0.7, 0.0)) && close(b.max.extend(0.0), Vec4::new(2.7, 1.7, 3.7, 0.0)), "{b:?}");
