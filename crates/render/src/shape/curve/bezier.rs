@@ -309,6 +309,12 @@ mod tests {
         // A linear B-spline is the polygon itself.
         let l = to_bezier_segments(Basis::BSpline, 1, &p[..3]).unwrap();
         assert_eq!(l.iter().map(|b| b.control_points().to_vec()).collect::<Vec<_>>(), [p[0..2].to_vec(), p[1..3].to_vec()]);
+        // The fewest points each basis takes: 4 for one cubic Bézier, B-spline or Catmull–Rom
+        // segment, 2 for a line; one point is no line.
+        assert_eq!(to_bezier_segments(Basis::Bezier, 3, &p[..4]).unwrap()[0].control_points(), &p[..4]);
+        assert_eq!(to_bezier_segments(Basis::BSpline, 1, &p[..2]).unwrap()[0].control_points(), &p[..2]);
+        assert_eq!(to_bezier_segments(Basis::CatmullRom, 3, &p[..4]).unwrap().len(), 1);
+        assert_eq!(to_bezier_segments(Basis::Bezier, 1, &p[..1]).unwrap_err(), "a Bézier curve of degree 1 needs 1·k + 1 points, found 1");
         assert_eq!(to_bezier_segments(Basis::Bezier, 0, &p).unwrap_err(), "degree must be 1, 2 or 3, found 0");
         assert_eq!(to_bezier_segments(Basis::Bezier, 3, &p[..1]).unwrap_err(), "a Bézier curve of degree 3 needs 3·k + 1 points, found 1");
         assert_eq!(to_bezier_segments(Basis::CatmullRom, 3, &p[..3]).unwrap_err(), "a Catmull–Rom spline needs at least 4 points, found 3");
