@@ -329,7 +329,8 @@ mod tests {
     #[test]
     fn tangents_are_angle_weighted_and_orthogonal_to_the_normal() {
         let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, -Vec3::Y, Vec3::new(1.0, -1.0, 0.0)];
-        let uvs = positions.iter().map(|p| if p.y < 0.0 { Vec2::new(p.y, -p.x) } else { Vec2::new(p.x, p.y) }).collect();
+        // (UVs moved by (½, ¼), which changes no derivative: no UV at 0 either)
+        let uvs = positions.iter().map(|p| Vec2::new(0.5, 0.25) + if p.y < 0.0 { Vec2::new(p.y, -p.x) } else { Vec2::new(p.x, p.y) }).collect();
         let positions = positions.iter().map(|p| *p + Vec3::new(0.5, -2.0, 3.0)).collect();
         let mut m = TriangleMesh { positions, uvs, indices: vec![[0, 1, 2], [0, 3, 4]], ..Default::default() };
         m.compute_tangents();
@@ -343,12 +344,19 @@ mod tests {
         m.normals = vec![Vec3::new(0.6, 0.0, 0.8); 5];
         m.compute_tangents();
         assert!(close(t(&m, 1).0, Vec3::new(0.8, 0.0, -0.6)) && t(&m, 1).1 == 1.0, "{:?}", t(&m, 1));
-        // UVs mirrored in u (uv = (-x, y) on A alone): ∂p/∂u = -x̂, and ẑ × (-x̂) = -ŷ is
-        // against ∂p/∂v = ŷ: sign -1.
-        let mut a = TriangleMesh { positions: vec![Vec3::ONE, Vec3::new(2.0, 1.0, 1.0), Vec3::new(1.0, 2.0, 1.0)], uvs: vec![Vec2::ZERO, -Vec2::X, Vec2::Y], indices: vec![[0, 1, 2]], ..Default::default() };
+        // UVs mirrored in u, in the plane y = 1: (1,1,1) (2,1,1) (1,1,2) with UVs (1,1) (0,1)
+        // (1,2), so ∂p/∂u = -x̂ and ∂p/∂v = ẑ; the face's normal x̂ × ẑ = -ŷ, and -ŷ × -x̂ = -ẑ
+        // is against ∂p/∂v: sign -1.
+        let mut a = TriangleMesh { positions: vec![Vec3::ONE, Vec3::new(2.0, 1.0, 1.0), Vec3::new(1.0, 1.0, 2.0)], uvs: vec![Vec2::ONE, Vec2::Y, Vec2::new(1.0, 2.0)], indices: vec![[0, 1, 2]], ..Default::default() };
         a.compute_tangents();
         for v in &a.tangents {
             assert!(close(v.truncate(), -Vec3::X) && v.w == -1.0, "{v}");
+        }
+        // UVs all equal give no derivatives: a unit tangent across the face's normal, sign +1.
+        a.uvs = vec![Vec2::ONE; 3];
+        a.compute_tangents();
+        for v in &a.tangents {
+            assert!((v.truncate().length() - 1.0).abs() < 1e-6 && v.y.abs() < 1e-6 && v.w == 1.0, "{v}");
         }
     }
 
