@@ -141,6 +141,9 @@ mod tests {
         assert!(c.intersect(0, &ray).is_none());
         let h = c.intersect(1, &ray).unwrap();
         assert!((h.t - 2.5).abs() < 1e-4 && (h.u - 0.5).abs() < 1e-4 && (h.v - 0.5).abs() < 1e-3, "{h:?}");
+        // The same ray with a direction of length 2: half the distance.
+        let h = c.intersect(1, &Ray::new(Vec3::new(1.5, 0.0, 3.0), Vec3::new(0.0, 0.0, -2.0))).unwrap();
+        assert!((h.t - 1.25).abs() < 1e-4 && (h.u - 0.5).abs() < 1e-4, "{h:?}");
         // Off the axis by ±¼ of the radius ½ (y = ±0.25, hits at z = √(¼ - 1/16)): v is ½ ± ¼,
         // one on each side.
         let [a, b] = [0.25f32, -0.25].map(|y| c.intersect(1, &Ray::new(Vec3::new(1.5, y, 3.0), -Vec3::Z)).unwrap());
