@@ -166,6 +166,20 @@ mod tests {
         assert!((h.t - 1.6).abs() < 1e-4 && h.u.abs() < 1e-6, "{h:?}");
     }
 
+    /// A bent strand, cut into leaves: the quadratic (0,0,0) (1,2,0) (2,0,0) of radius 0.05 is
+    /// p(u) = (2u, 4u(1 - u), 0). Rays down z onto p(½) = (1, 1) and p(¼) = (0.5, 0.75) meet
+    /// the tube's top, z = 0.05, at t = 2.95, the leaves' chords within 0.02r of the curve.
+    #[test]
+    fn bent_strand_hits_by_hand() {
+        let c = Curve::new(vec![Bezier::new(&[Vec4::new(0.0, 0.0, 0.0, 0.05), Vec4::new(1.0, 2.0, 0.0, 0.05), Vec4::new(2.0, 0.0, 0.0, 0.05)]).unwrap()], MaterialId(0));
+        assert!(c.cubics[0].1 > 0);
+        for (x, y, u) in [(1.0, 1.0, 0.5), (0.5, 0.75, 0.25)] {
+            let h = c.intersect(0, &Ray::new(Vec3::new(x, y, 3.0), -Vec3::Z)).unwrap();
+            assert!((h.t - 2.95).abs() < 2e-3 && (h.u - u).abs() < 1e-2, "{x} {y}: {h:?}");
+        }
+        assert!(c.intersect(0, &Ray::new(Vec3::new(1.0, 1.1, 3.0), -Vec3::Z)).is_none());
+    }
+
     /// The surface at hits given by hand (the point is o + t·d): the normal is the offset from
     /// the axis at u without its part along the axis, but at the strand's two round ends the
     /// whole offset; uv.x runs over the strand, (seg + u)/2; ∂p/∂u is the segment's tangent
