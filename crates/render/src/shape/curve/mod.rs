@@ -178,6 +178,12 @@ mod tests {
             assert!((h.t - 2.95).abs() < 2e-3 && (h.u - u).abs() < 1e-2, "{x} {y}: {h:?}");
         }
         assert!(c.intersect(0, &Ray::new(Vec3::new(1.0, 1.1, 3.0), -Vec3::Z)).is_none());
+        // Its end raised to z = 1 (z = u², so the second half is the nearer from above): over
+        // p(½) = (1, 1, ¼) the axis leans along (2, 0, 1)/√5, and the vertical line meets the
+        // tube r·√5/2 above the axis: t ≈ 3 - ¼ - 0.0559.
+        let c = Curve::new(vec![Bezier::new(&[Vec4::new(0.0, 0.0, 0.0, 0.05), Vec4::new(1.0, 2.0, 0.0, 0.05), Vec4::new(2.0, 0.0, 1.0, 0.05)]).unwrap()], MaterialId(0));
+        let h = c.intersect(0, &Ray::new(Vec3::new(1.0, 1.0, 3.0), -Vec3::Z)).unwrap();
+        assert!((h.t - (2.75 - 0.05 * 5f32.sqrt() / 2.0)).abs() < 1e-2 && (h.u - 0.5).abs() < 3e-2, "{h:?}");
     }
 
     /// The surface at hits given by hand (the point is o + t·d): the normal is the offset from
