@@ -226,6 +226,140 @@ fn uv_derivatives(e1: Vec3, e2: Vec3, d1: Vec2, d2: Vec2) -> Option<(Vec3, Vec3)
 mod tests {
     use super::*;
 
+    /// One triangle p0 = (-1, 1, 0), p1 = p0 + e1, p2 = p0 + e2 with e1 = (4, 0, 0) and
+    /// e2 = (0, 2, -2): e1 × e2 = (0, 8, 8), so the winding normal is (0, 1, 1)/√2 and the
+    /// area ½·√128 = 4√2.
+    fn tri(uvs: Vec<Vec2>, normals: Vec<Vec3>) -> TriangleMesh {
+        TriangleMesh { positions: vec![Vec3::new(-1.0, 1.0, 0.0), Vec3::new(3.0, 1.0, 0.0), Vec3::new(-1.0, 3.0, -2.0)], uvs, normals, indices: vec![[0, 1, 2]], ..Default::default() }
+    }
+
+    fn close(a: Vec3, b: Vec3) -> bool {
+        (a - b).length() < 1e-6
+    }
+
+    #[test]
+    fn one_triangle_by_hand() {
+        let m = tri(vec![], vec![]);
+        assert_eq!((m.len(), m.is_empty()), (1, false));
+        assert!(TriangleMesh::default().is_empty());
+        assert!(close(m.winding_normal(0), Vec3::new(0.0, 1.0, 1.0) / 2f32.sqrt()));
+        assert!((m.area(0) - 4.0 * 2f32.sqrt()).abs() < 1e-6, "{}", m.area(0));
+        let b = m.triangle_bounds(0);
+        assert_eq!((b.min, b.max), (Vec3::new(-1.0, 1.0, -2.0), Vec3::new(3.0, 3.0, 0.0)));
+        // A position no triangle uses is not in the mesh's bounds.
+        let mut with_unused = tri(vec![], vec![]);
+        with_unused.positions.push(Vec3::splat(100.0));
+        let b = with_unused.bounds();
+        assert_eq!((b.min, b.max), (Vec3::new(-1.0, 1.0, -2.0), Vec3::new(3.0, 3.0, 0.0)));
+        // A ray down y onto (0, 2, -1) = p0 + ¼e1 + ½e2: barycentrics (¼, ½) at t = 1.
+        assert_eq!(m.intersect(0, &Ray::new(Vec3::new(0.0, 3.0, -1.0), -Vec3::Y)), Some((1.0, 0.25, 0.5)));
+        // A degenerate triangle (three points on a line) has no normal: +y stands in.
+        let line = TriangleMesh { positions: vec![Vec3::ZERO, Vec3::X, 2.0 * Vec3::X], indices: vec![[0, 1, 2]], ..Default::default() };
+        assert_eq!((line.winding_normal(0), line.area(0)), (Vec3::Y, 0.0));
+    }
+
+    #[test]
+    fn surface_without_uvs_or_normals() {
+        let m = tri(vec![], vec![]);
+        let g = m.surface(0, 0.25, 0.5);
+        // ¼p0 + ¼p1 + ½p2 = (-0.25 + 0.75 - 0.5, 0.25 + 0.25 + 1.5, -1)
+        assert_eq!(g.p, Vec3::new(0.0, 2.0, -1.0));
+        // pbrt-v4's bound γ₇(|b0·p0| + |b1·p1| + |b2·p2|), not γ₇|p|: x sums 0.25 + 0.75 + 0.5.
+        let g7 = 7.0 * f64::from(f32::EPSILON) * 0.5;
+        let expected = [g7 * 1.5, g7 * 2.0, g7 * 1.0];
+        for (k, e) in expected.into_iter().enumerate() {
+            assert!((f64::from(g.p_error[k]) - e).abs() <= 1e-3 * e, "{k}: {}", g.p_error);
+        }
+        let n = Vec3::new(0.0, 1.0, 1.0) / 2f32.sqrt();
+        assert!(close(g.ng, n) && g.ns == g.ng, "{} {}", g.ng, g.ns);
+        assert_eq!((g.uv, g.dpdu, g.dpdv), (Vec2::new(0.25, 0.5), Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 2.0, -2.0)));
+    }
+
+    /// UVs t0 = (½, ¼), t1 = (1, ½), t2 = (¼, 1): the UV edges d1 = (½, ¼), d2 = (-¼, ¾). The
+    /// point is linear in uv, so ∂p/∂u·d.x + ∂p/∂v·d.y must give back each edge e (e1 for d1,
+    /// e2 for d2): that pins both derivatives, whatever formula computes them.
+    #[test]
+    fn surface_with_uvs_has_the_derivatives_that_map_uv_edges_to_edges() {
+        let m = tri(vec![Vec2::new(0.5, 0.25), Vec2::new(1.0, 0.5), Vec2::new(0.25, 1.0)], vec![]);
+        let g = m.surface(0, 0.25, 0.5);
+        // ¼t0 + ¼t1 + ½t2
+        assert!((g.uv - Vec2::new(0.5, 0.6875)).length() < 1e-7, "{}", g.uv);
+        let (e1, e2) = (Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 2.0, -2.0));
+        assert!(close(0.5 * g.dpdu + 0.25 * g.dpdv, e1), "{} {}", g.dpdu, g.dpdv);
+        assert!(close(-0.25 * g.dpdu + 0.75 * g.dpdv, e2), "{} {}", g.dpdu, g.dpdv);
+        // All three UVs equal: no derivatives from them, the edges stand in.
+        let flat = tri(vec![Vec2::ONE; 3], vec![]);
+        let g = flat.surface(0, 0.25, 0.5);
+        assert_eq!((g.uv, g.dpdu, g.dpdv), (Vec2::ONE, e1, e2));
+    }
+
+    /// Vertex normals interpolated by the barycentrics (¼, ¼, ½ for b = (¼, ½)), and the
+    /// geometric normal (0, 1, 1)/√2 turned to their side.
+    #[test]
+    fn surface_interpolates_vertex_normals_and_turns_ng_to_their_side() {
+        let ng = Vec3::new(0.0, 1.0, 1.0) / 2f32.sqrt();
+        // ¼ŷ + ¼(-ẑ) + ½x̂ = (½, ¼, -¼): along ng, 0; ng stays.
+        let g = tri(vec![], vec![Vec3::Y, -Vec3::Z, Vec3::X]).surface(0, 0.25, 0.5);
+        assert!(close(g.ns, Vec3::new(0.5, 0.25, -0.25) / 0.375f32.sqrt()) && close(g.ng, ng), "{} {}", g.ns, g.ng);
+        // ¼(-ŷ) + ¼(-ẑ) + ½x̂ = (½, -¼, -¼): against ng, which turns.
+        let g = tri(vec![], vec![-Vec3::Y, -Vec3::Z, Vec3::X]).surface(0, 0.25, 0.5);
+        assert!(close(g.ns, Vec3::new(0.5, -0.25, -0.25) / 0.375f32.sqrt()) && close(g.ng, -ng), "{} {}", g.ns, g.ng);
+        // ŷ + ½(-ŷ) + ... : (0, ¼, 0) + (0, -¼, 0)... normals summing to zero fall back to ng.
+        let g = tri(vec![], vec![Vec3::Y, -Vec3::Y, Vec3::X]).surface(0, 0.5, 0.0);
+        assert!(close(g.ns, ng) && close(g.ng, ng), "{} {}", g.ns, g.ng);
+    }
+
+    #[test]
+    fn interpolated_tangents_and_their_sign() {
+        let mut m = tri(vec![], vec![]);
+        assert_eq!(m.interpolated_tangent(0, 0.25, 0.5), None);
+        m.tangents = vec![Vec4::new(1.0, 0.0, 0.0, 1.0), Vec4::new(0.0, 1.0, 0.0, 1.0), Vec4::new(0.0, 0.0, 1.0, -1.0)];
+        // ¼t0 + ¼t1 + ½t2: w = ¼ + ¼ - ½ = 0 counts as +1; at (¼, 0.6), w = -0.2 < 0.
+        assert_eq!(m.interpolated_tangent(0, 0.25, 0.5), Some((Vec3::new(0.25, 0.25, 0.5), 1.0)));
+        let (t, w) = m.interpolated_tangent(0, 0.25, 0.625).unwrap();
+        assert!(close(t, Vec3::new(0.125, 0.25, 0.625)) && w == -1.0, "{t} {w}");
+    }
+
+    /// Two faces in z = 0 around the vertex O = (0, 0, 0), their UVs chosen so that ∂p/∂u is
+    /// x̂ on A = O (1,0,0) (0,1,0) (uv = (x, y): ∂p/∂v = ŷ), and ŷ on B = O (0,-1,0) (1,-1,0)
+    /// (uv = (y, -x): ∂p/∂v = -x̂). A's corner at O is 90°, B's 45°, so O's tangent is
+    /// (π/2·x̂ + π/4·ŷ) normalised, (2, 1, 0)/√5; its sign +1 (ẑ × t along π/2·ŷ - π/4·x̂).
+    /// A's other corners take A's frame alone (x̂, +1); B's (ŷ, +1). The whole is then moved
+    /// by (0.5, -2, 3) (no vertex at the origin), which changes none of that.
+    #[test]
+    fn tangents_are_angle_weighted_and_orthogonal_to_the_normal() {
+        let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, -Vec3::Y, Vec3::new(1.0, -1.0, 0.0)];
+        // (UVs moved by (½, ¼), which changes no derivative: no UV at 0 either)
+        let uvs = positions.iter().map(|p| Vec2::new(0.5, 0.25) + if p.y < 0.0 { Vec2::new(p.y, -p.x) } else { Vec2::new(p.x, p.y) }).collect();
+        let positions = positions.iter().map(|p| *p + Vec3::new(0.5, -2.0, 3.0)).collect();
+        let mut m = TriangleMesh { positions, uvs, indices: vec![[0, 1, 2], [0, 3, 4]], ..Default::default() };
+        m.compute_tangents();
+        let t = |m: &TriangleMesh, i: usize| (m.tangents[i].truncate(), m.tangents[i].w);
+        assert!(close(t(&m, 0).0, Vec3::new(2.0, 1.0, 0.0) / 5f32.sqrt()) && t(&m, 0).1 == 1.0, "{:?}", t(&m, 0));
+        for (i, expected) in [(1, Vec3::X), (2, Vec3::X), (3, Vec3::Y), (4, Vec3::Y)] {
+            assert!(close(t(&m, i).0, expected) && t(&m, i).1 == 1.0, "{i}: {:?}", t(&m, i));
+        }
+        // With vertex normals leaning to (0.6, 0, 0.8), Gram–Schmidt: x̂ - 0.6·n = (0.64, 0,
+        // -0.48), normalised (0.8, 0, -0.6) at A's corner (1, 0, 0).
+        m.normals = vec![Vec3::new(0.6, 0.0, 0.8); 5];
+        m.compute_tangents();
+        assert!(close(t(&m, 1).0, Vec3::new(0.8, 0.0, -0.6)) && t(&m, 1).1 == 1.0, "{:?}", t(&m, 1));
+        // UVs mirrored in u, in the plane y = 1: (1,1,1) (2,1,1) (1,1,2) with UVs (1,1) (0,1)
+        // (1,2), so ∂p/∂u = -x̂ and ∂p/∂v = ẑ; the face's normal x̂ × ẑ = -ŷ, and -ŷ × -x̂ = -ẑ
+        // is against ∂p/∂v: sign -1.
+        let mut a = TriangleMesh { positions: vec![Vec3::ONE, Vec3::new(2.0, 1.0, 1.0), Vec3::new(1.0, 1.0, 2.0)], uvs: vec![Vec2::ONE, Vec2::Y, Vec2::new(1.0, 2.0)], indices: vec![[0, 1, 2]], ..Default::default() };
+        a.compute_tangents();
+        for v in &a.tangents {
+            assert!(close(v.truncate(), -Vec3::X) && v.w == -1.0, "{v}");
+        }
+        // UVs all equal give no derivatives: a unit tangent across the face's normal, sign +1.
+        a.uvs = vec![Vec2::ONE; 3];
+        a.compute_tangents();
+        for v in &a.tangents {
+            assert!((v.truncate().length() - 1.0).abs() < 1e-6 && v.y.abs() < 1e-6 && v.w == 1.0, "{v}");
+        }
+    }
+
     #[test]
     fn smooth_normals_weld_split_vertices_and_weight_by_angle() {
         // A roof: two faces meeting at the ridge x = 0, the ridge vertices duplicated.
@@ -245,6 +379,43 @@ mod tests {
         // The eaves belong to one face each.
         let left = Vec3::new(-1.0, 1.0, 0.0).normalize();
         assert!((mesh.normals[2] - left).length() < 1e-6, "{}", mesh.normals[2]);
+    }
+
+    /// -0 and +0 are one position: the roof's ridge copies at x = -0 and x = +0 weld, and
+    /// get the two faces' average, straight up.
+    #[test]
+    fn smooth_normals_weld_minus_zero_with_zero() {
+        let mut mesh = TriangleMesh {
+            positions: vec![
+                Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 1.0), Vec3::new(-1.0, 0.0, 0.0),
+                Vec3::new(-0.0, 1.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(-0.0, 1.0, 1.0),
+            ],
+            indices: vec![[0, 2, 1], [3, 5, 4]],
+            ..Default::default()
+        };
+        mesh.compute_smooth_normals(180.0);
+        for i in [0, 1, 3, 5] {
+            assert!((mesh.normals[i] - Vec3::Y).length() < 1e-6, "{i}: {}", mesh.normals[i]);
+        }
+    }
+
+    /// Coplanar faces join even under a crease angle of 0 (the slack of 10⁻⁶ in the cosine),
+    /// whatever the rounding of their normals: a fan of four triangles around (0.3, 0.7, 0)
+    /// in z = 0 keeps one normal, +z, per vertex, and no vertex is split; a copy of a vertex
+    /// that no triangle uses takes the normal at its position.
+    #[test]
+    fn coplanar_faces_join_at_a_crease_angle_of_zero() {
+        let mut mesh = TriangleMesh {
+            positions: vec![Vec3::new(0.3, 0.7, 0.0), Vec3::ZERO, Vec3::new(1.1, 0.0, 0.0), Vec3::new(1.1, 1.3, 0.0), Vec3::new(0.0, 1.3, 0.0), Vec3::new(1.1, 1.3, 0.0)],
+            indices: vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]],
+            uvs: vec![Vec2::ZERO; 6],
+            ..Default::default()
+        };
+        mesh.compute_smooth_normals(0.0);
+        assert_eq!((mesh.positions.len(), mesh.uvs.len()), (6, 6));
+        for (i, n) in mesh.normals.iter().enumerate() {
+            assert!((*n - Vec3::Z).length() < 1e-6, "{i}: {n}");
+        }
     }
 
     #[test]

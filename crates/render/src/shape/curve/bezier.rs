@@ -276,6 +276,53 @@ mod tests {
     }
 
     #[test]
+    fn radius_bounds_and_transform_by_hand() {
+        let q = Bezier::new(&[Vec4::new(1.0, 1.0, 1.0, 0.3), Vec4::new(2.0, -1.0, 0.0, 0.7), Vec4::new(0.0, 0.0, 3.0, 0.2)]).unwrap();
+        assert_eq!(q.max_radius(), 0.7);
+        // At u = ½: ¼·0.3 + ½·0.7 + ¼·0.2.
+        assert!((q.radius(0.5) - 0.475).abs() < 1e-6, "{}", q.radius(0.5));
+        // The hull (0, -1, 0)–(2, 1, 3) grown by 0.7.
+        let b = q.bounds();
+        assert!(close(b.min.extend(0.0), Vec4::new(-0.7, -1.7, -0.7, 0.0)) && close(b.max.extend(0.0), Vec4::new(2.7, 1.7, 3.7, 0.0)), "{b:?}");
+        // Scaled by (2, 4, 1) (determinant 8: radii × ∛8 = 2), then moved by (1, 0, 0).
+        let to_world = Transform::scale(Vec3::new(2.0, 4.0, 1.0)).unwrap().then(Transform::translate(Vec3::X));
+        let t = q.transformed(&to_world);
+        let want = [Vec4::new(3.0, 4.0, 1.0, 0.6), Vec4::new(5.0, -4.0, 0.0, 1.4), Vec4::new(1.0, 0.0, 3.0, 0.4)];
+        assert_eq!(t.degree(), 2);
+        assert!(t.control_points().iter().zip(&want).all(|(a, w)| close(*a, *w)), "{t:?}");
+        // A mirror (determinant -1) keeps the radii.
+        let m = q.transformed(&Transform::scale(Vec3::new(-1.0, 1.0, 1.0)).unwrap());
+        assert!(close(m.control_points()[1], Vec4::new(-2.0, -1.0, 0.0, 0.7)), "{m:?}");
+        assert_eq!(Bezier::new(&[Vec4::ZERO]), None);
+        assert_eq!(Bezier::new(&[Vec4::ZERO; 5]), None);
+    }
+
+    #[test]
+    fn bezier_and_linear_bases_split_the_points_by_hand() {
+        let p: Vec<Vec4> = (0..7).map(|i| Vec4::new(i as f32, (i * i) as f32, 0.0, 0.1 * i as f32)).collect();
+        // Cubic Bézier segments share their ends: points 0–3 and 3–6.
+        let c = to_bezier_segments(Basis::Bezier, 3, &p).unwrap();
+        assert_eq!(c.iter().map(|b| b.control_points().to_vec()).collect::<Vec<_>>(), [p[0..4].to_vec(), p[3..7].to_vec()]);
+        // Quadratic: 0–2, 2–4, 4–6.
+        let q = to_bezier_segments(Basis::Bezier, 2, &p).unwrap();
+        assert_eq!(q.iter().map(|b| b.control_points().to_vec()).collect::<Vec<_>>(), [p[0..3].to_vec(), p[2..5].to_vec(), p[4..7].to_vec()]);
+        // A linear B-spline is the polygon itself.
+        let l = to_bezier_segments(Basis::BSpline, 1, &p[..3]).unwrap();
+        assert_eq!(l.iter().map(|b| b.control_points().to_vec()).collect::<Vec<_>>(), [p[0..2].to_vec(), p[1..3].to_vec()]);
+        // The fewest points each basis takes: 4 for one cubic Bézier, B-spline or Catmull–Rom
+        // segment, 2 for a line; one point is no line.
+        assert_eq!(to_bezier_segments(Basis::Bezier, 3, &p[..4]).unwrap()[0].control_points(), &p[..4]);
+        assert_eq!(to_bezier_segments(Basis::BSpline, 1, &p[..2]).unwrap()[0].control_points(), &p[..2]);
+        assert_eq!(to_bezier_segments(Basis::CatmullRom, 3, &p[..4]).unwrap().len(), 1);
+        assert_eq!(to_bezier_segments(Basis::Bezier, 1, &p[..1]).unwrap_err(), "a Bézier curve of degree 1 needs 1·k + 1 points, found 1");
+        assert_eq!(to_bezier_segments(Basis::Bezier, 0, &p).unwrap_err(), "degree must be 1, 2 or 3, found 0");
+        assert_eq!(to_bezier_segments(Basis::Bezier, 3, &p[..1]).unwrap_err(), "a Bézier curve of degree 3 needs 3·k + 1 points, found 1");
+        assert_eq!(to_bezier_segments(Basis::CatmullRom, 3, &p[..3]).unwrap_err(), "a Catmull–Rom spline needs at least 4 points, found 3");
+        assert_eq!(["bezier", "bspline", "catmull-rom"].map(|s| s.parse::<Basis>().unwrap()), [Basis::Bezier, Basis::BSpline, Basis::CatmullRom]);
+        assert_eq!("nurbs".parse::<Basis>().unwrap_err(), "unknown basis `nurbs` (valid: bezier, bspline, catmull-rom)");
+    }
+
+    #[test]
     fn control_point_counts_are_checked() {
         let p = vec![Vec4::ZERO; 6];
         assert_eq!(to_bezier_segments(Basis::Bezier, 3, &p).unwrap_err(), "a Bézier curve of degree 3 needs 3·k + 1 points, found 6");
