@@ -170,10 +170,13 @@ fn data_uri(data: &str) -> Result<Vec<u8>, String> {
     base64::decode(payload.trim()).map_err(|e| format!("the base64 payload of `data:{header},...` does not decode: {e}"))
 }
 
+/// Reads a URI (relative to the file, for the field named) into bytes.
+type ReadUri<'a> = dyn Fn(&str, &str) -> Result<Vec<u8>, LoadError> + 'a;
+
 /// An image texture of the file, its texels times `scale`: decoded from sRGB for colours,
 /// linear for data (normals, metalness and roughness).
 #[allow(clippy::too_many_arguments)]
-fn image_texture(path: &Path, buffers: &[Vec<u8>], read_uri: &dyn Fn(&str, &str) -> Result<Vec<u8>, LoadError>, texture: gltf::Texture, srgb: bool, scale: Rgb, field: &str) -> Result<ImageTexture, LoadError> {
+fn image_texture(path: &Path, buffers: &[Vec<u8>], read_uri: &ReadUri<'_>, texture: gltf::Texture, srgb: bool, scale: Rgb, field: &str) -> Result<ImageTexture, LoadError> {
     let bytes = match texture.source().source() {
         gltf::image::Source::View { view, .. } => {
             let buffer = &buffers[view.buffer().index()];
@@ -194,7 +197,7 @@ fn image_texture(path: &Path, buffers: &[Vec<u8>], read_uri: &dyn Fn(&str, &str)
 /// `base·(1 - metallic)`, `f0 = lerp(0.04, base, metallic)`, GGX α = roughness²), with the
 /// metallic-roughness texture read per shading point. The base-colour factor multiplies the
 /// texture's texels on load (exact: filtering is linear).
-fn material(path: &Path, doc: &gltf::Gltf, buffers: &[Vec<u8>], read_uri: &dyn Fn(&str, &str) -> Result<Vec<u8>, LoadError>, k: usize, desc: &mut SceneDescription) -> Result<MaterialId, LoadError> {
+fn material(path: &Path, doc: &gltf::Gltf, buffers: &[Vec<u8>], read_uri: &ReadUri<'_>, k: usize, desc: &mut SceneDescription) -> Result<MaterialId, LoadError> {
     let m = doc.materials().nth(k).expect("index from the file");
     let pbr = m.pbr_metallic_roughness();
     let [r, g, b, _] = pbr.base_color_factor();

@@ -576,7 +576,7 @@ impl Parser {
                     None if positions.len() == per => (0..per as u32).collect(),
                     None => return Err(span.err("needs \"integer indices\"")),
                 };
-                if idx.len() % per != 0 {
+                if !idx.len().is_multiple_of(per) {
                     return Err(span.err(format!("\"indices\" needs a multiple of {per} values, found {}", idx.len())));
                 }
                 // A bilinear patch's vertices are p00, p10, p01, p11: two triangles.

@@ -111,7 +111,7 @@ fn ground(scene: &mut SceneDescription, y: f32, half: f32, material: MaterialId)
 fn balls(size: u32) -> Generated {
     let (mut g, p) = base(&format!("SPD balls (sphereflake), depth {size}"), Vec3::new(2.1, 1.3, 1.7) * 1.6, Vec3::new(0.0, 0.0, 0.0), 45.0);
     fn flake(scene: &mut SceneDescription, p: &Palette, c: Vec3, r: f32, dir: Vec3, depth: u32) {
-        sphere(scene, c, r, if depth % 2 == 0 { p.mirror } else { p.a });
+        sphere(scene, c, r, if depth.is_multiple_of(2) { p.mirror } else { p.a });
         if depth == 0 {
             return;
         }
@@ -186,7 +186,7 @@ fn mount(size: u32) -> Generated {
             }
         }
         for y in (0..=n).step_by(half) {
-            let start = if (y / half) % 2 == 0 { half } else { 0 };
+            let start = if (y / half).is_multiple_of(2) { half } else { 0 };
             for x in (start..=n).step_by(step) {
                 let mut sum = 0.0;
                 let mut cnt = 0.0;

@@ -141,6 +141,7 @@ impl TriangleMesh {
         };
         let mut normals: Vec<Option<Vec3>> = vec![None; self.positions.len()];
         let mut copies = std::collections::HashMap::new();
+        #[allow(clippy::needless_range_loop)] // the loop rewrites `self.indices[f]` and grows `self.positions`
         for f in 0..self.indices.len() {
             for k in 0..3 {
                 let v = self.indices[f][k] as usize;
