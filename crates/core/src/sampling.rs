@@ -73,7 +73,7 @@ mod tests {
     #[test]
     fn jittered_cells_cover_the_square_once() {
         let n = 4;
-        let mut seen = vec![false; 16];
+        let mut seen = [false; 16];
         for i in 0..16 {
             let p = jittered(i, n, Vec2::splat(0.5));
             let cell = (p.y * 4.0) as usize * 4 + (p.x * 4.0) as usize;

@@ -45,7 +45,7 @@ pub(crate) fn color(i: usize) -> RGBColor {
         return PALETTE[i];
     }
     let hue = ((i - PALETTE.len()) as f64 * 137.508 + 15.0) % 360.0;
-    let light = if (i / 7) % 2 == 0 { 0.4 } else { 0.62 };
+    let light = if (i / 7).is_multiple_of(2) { 0.4 } else { 0.62 };
     let c = HSLColor(hue / 360.0, 0.75, light).to_rgba();
     RGBColor(c.0, c.1, c.2)
 }
@@ -220,7 +220,7 @@ fn loglog_chart_in(title: &str, x_desc: &str, y_desc: &str, series: &BTreeMap<St
     if svg.is_empty() {
         return svg;
     }
-    format!("<div class=\"plot\">{}{}</div>", figure("loglog", title, "log", &svg), html_legend(&names, &colors))
+    format!("<div class=\"plot\">{}{}</div>", figure("loglog", title, "log", &svg), html_legend(&names, colors))
 }
 
 /// The SVG of a log–log plot; `front` (indices into the flattened points) are drawn large and

@@ -202,7 +202,7 @@ impl Shape {
     fn ray_from_inside(&self, rng: &mut Pcg32, k: u64) -> Ray {
         let origin = self.inside(rng);
         let target = match self.kind {
-            PrimKind::Triangles if k % 2 == 0 => self.vertices[rng.below(self.vertices.len() as u32) as usize],
+            PrimKind::Triangles if k.is_multiple_of(2) => self.vertices[rng.below(self.vertices.len() as u32) as usize],
             PrimKind::Triangles => {
                 let [a, b] = self.edges[rng.below(self.edges.len() as u32) as usize];
                 a + (b - a) * rng.next_f32()

@@ -97,7 +97,7 @@ pub fn parse_duration(s: &str) -> Result<Duration, String> {
         _ => return Err(format!("`{s}`: unknown unit `{unit}` (valid: ms, s, m, h)")),
     };
     let secs = v * scale;
-    if !(secs.is_finite() && secs >= 0.0 && secs < 1e9) {
+    if !(secs.is_finite() && (0.0..1e9).contains(&secs)) {
         return Err(format!("`{s}` is not a duration between 0 and 10^9 seconds"));
     }
     Ok(Duration::from_secs_f64(secs))
@@ -195,7 +195,7 @@ pub fn read_film(path: &Path) -> Result<Film> {
 
 /// Writes a film atomically.
 pub fn write_film(path: &Path, film: &Film) -> Result<()> {
-    write_atomic(path, &film.to_bytes()).with_context(|| format!("{}: cannot write", path.display()))
+    write_atomic(path, film.to_bytes()).with_context(|| format!("{}: cannot write", path.display()))
 }
 
 /// The signal flags: `cancel` stops the render after the pass in flight is dropped; a

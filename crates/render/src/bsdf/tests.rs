@@ -602,7 +602,8 @@ fn cook_torrance_reference(distribution: Distribution, alpha: f64, fresnel: impl
     let h = [s[0] / len, s[1] / len, s[2] / len];
     let cos_oh = o[0] * h[0] + o[1] * h[1] + o[2] * h[2];
     let (a2, cos2h, tan2h) = (alpha * alpha, h[2] * h[2], tan2_of(h));
-    let (d, lambda): (f64, Box<dyn Fn([f64; 3]) -> f64>) = match distribution {
+    type Lambda = Box<dyn Fn([f64; 3]) -> f64>;
+    let (d, lambda): (f64, Lambda) = match distribution {
         // Walter et al. 2007, eqs. 25 and 33.
         Distribution::Beckmann => ((-tan2h / a2).exp() / (PI64 * a2 * cos2h * cos2h), Box::new(move |w| 1.0 / walter_beckmann_g1(alpha, w) - 1.0)),
         Distribution::Ggx => (a2 / (PI64 * cos2h * cos2h * (a2 + tan2h).powi(2)), Box::new(move |w| 0.5 * ((1.0 + a2 * tan2_of(w)).sqrt() - 1.0))),
