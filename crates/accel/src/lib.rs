@@ -19,6 +19,7 @@ mod par;
 pub mod primitives;
 pub mod sphere_bvh;
 pub mod stats;
+mod tree;
 pub mod wide;
 
 use std::fmt;

@@ -9,7 +9,7 @@
 use rayon::prelude::*;
 use raylab_core::{Aabb, BoundingSphere, Ray, Vec3};
 
-use crate::bvh::traverse::{any_in_tree, closest_in_tree, tree_stats, TreeNode};
+use crate::tree::{any_in_tree, closest_in_tree, tree_stats, validate_tree, Containment, TreeNode};
 use crate::bvh::{lbvh, ploc, SahCost};
 use crate::{leaf_margin, Accel, AccelStats, BuildOptions, Counters, Hit, Primitives, ValidationError};
 
@@ -75,24 +75,6 @@ impl SphereBvh {
             .collect();
         Self { nodes, indices, primitives: n, build_ms: 0.0 }
     }
-
-    /// Visits every node. Only children stored after their parent are followed, so that a
-    /// broken tree whose children point back cannot make the walk loop for ever (`validate`
-    /// reports them).
-    fn visit(&self, mut f: impl FnMut(usize)) {
-        if self.nodes.is_empty() {
-            return;
-        }
-        let mut stack = vec![0usize];
-        while let Some(i) = stack.pop() {
-            f(i);
-            let n = &self.nodes[i];
-            if !n.is_leaf() && (n.left_first as usize) > i && (n.left_first as usize) + 1 < self.nodes.len() {
-                stack.push(n.left_first as usize);
-                stack.push(n.left_first as usize + 1);
-            }
-        }
-    }
 }
 
 /// `inner` lies inside `outer` up to [`CONTAINMENT_TOLERANCE`].
@@ -142,60 +124,16 @@ impl Accel for SphereBvh {
     }
 
     fn validate<P: Primitives + ?Sized>(&self, prims: &P) -> Result<(), ValidationError> {
-        let err = |m: String| Err(ValidationError::new("sphere-bvh", m));
-        if prims.len() != self.primitives {
-            return err(format!("built for {} primitives, given {}", self.primitives, prims.len()));
-        }
-        if self.nodes.is_empty() {
-            return if prims.is_empty() { Ok(()) } else { err("no nodes for a non-empty scene".into()) };
-        }
-        let mut problem = None;
-        let mut reached = vec![false; self.nodes.len()];
-        let mut seen = vec![0u32; prims.len()];
-        self.visit(|i| {
-            if problem.is_some() {
-                return;
+        let leaf_holds = |i: usize, n: &SphereNode, p: u32| {
+            let (b, s) = (prims.bounds(p), n.sphere());
+            let far = (b.centroid() - s.center).abs() + 0.5 * b.extent();
+            if far.length() > s.radius * (1.0 + CONTAINMENT_TOLERANCE) {
+                return Err(format!("primitive {p} sticks out of leaf {i}"));
             }
-            if std::mem::replace(&mut reached[i], true) {
-                problem = Some(format!("node {i} reached twice"));
-                return;
-            }
-            let n = &self.nodes[i];
-            let s = n.sphere();
-            let (first, count) = (n.left_first as usize, n.count as usize);
-            if n.is_leaf() {
-                let Some(leaf) = self.indices.get(first..first + count) else {
-                    problem = Some(format!("leaf {i} points past the index array"));
-                    return;
-                };
-                for &p in leaf {
-                    if p as usize >= prims.len() {
-                        problem = Some(format!("leaf {i} holds primitive {p} of {}", prims.len()));
-                        return;
-                    }
-                    let b = prims.bounds(p);
-                    seen[p as usize] += 1;
-                    let far = (b.centroid() - s.center).abs() + 0.5 * b.extent();
-                    if far.length() > s.radius * (1.0 + CONTAINMENT_TOLERANCE) {
-                        problem = Some(format!("primitive {p} sticks out of leaf {i}"));
-                    }
-                }
-            } else if first + 1 >= self.nodes.len() || first <= i {
-                problem = Some(format!("node {i} has children {first}, {} out of order or range", first + 1));
-            } else if let Some(c) = [first, first + 1].into_iter().find(|&c| !sphere_contains(&s, &self.nodes[c].sphere())) {
-                problem = Some(format!("child {c} sticks out of node {i}"));
-            }
-        });
-        if let Some(m) = problem {
-            return err(m);
-        }
-        if let Some(i) = reached.iter().position(|r| !r) {
-            return err(format!("node {i} is unreachable"));
-        }
-        if let Some(p) = seen.iter().position(|&c| c != 1) {
-            return err(format!("primitive {p} is in {} leaves, not one", seen[p]));
-        }
-        Ok(())
+            Ok(())
+        };
+        let child_inside = |n: &SphereNode, c: &SphereNode| sphere_contains(&n.sphere(), &c.sphere());
+        validate_tree("sphere-bvh", &self.nodes, &self.indices, self.primitives, prims, Containment { child_inside, leaf_holds, each_once: true })
     }
 }
 
@@ -322,8 +260,9 @@ mod tests {
         assert_eq!(check(shared, vec![0, 1], 2).unwrap_err(), "node 4 reached twice");
         // A node no one points to, and a primitive in two leaves or in none.
         assert_eq!(check(vec![node(1, 0), node(0, 1), node(1, 1), node(0, 1)], vec![0, 1], 2).unwrap_err(), "node 3 is unreachable");
-        assert_eq!(check(vec![node(1, 0), node(0, 1), node(1, 1)], vec![0, 0], 2).unwrap_err(), "primitive 0 is in 2 leaves, not one");
-        assert_eq!(check(vec![node(0, 1)], vec![0], 2).unwrap_err(), "primitive 1 is in 0 leaves, not one");
+        assert_eq!(check(vec![node(1, 0), node(0, 1), node(1, 2)], vec![0, 0, 1], 2).unwrap_err(), "primitive 0 is in 2 leaves, not one");
+        assert_eq!(check(vec![node(1, 0), node(0, 1), node(1, 1)], vec![0, 0], 2).unwrap_err(), "primitive 1 is in no leaf");
+        assert_eq!(check(vec![node(0, 1)], vec![0], 2).unwrap_err(), "primitive 1 is in no leaf");
         // Counts and emptiness.
         assert_eq!(check(vec![], vec![], 2).unwrap_err(), "no nodes for a non-empty scene");
         check(vec![], vec![], 0).unwrap();

@@ -6,7 +6,7 @@
 //! (Issue 15: these were found missing by mutation testing; the oracle and quality tests
 //! check that trees work and are good, not which tree a builder makes.)
 
-use raylab_accel::bvh::{self, lbvh, Bvh, BvhNode, SplitMethod};
+use raylab_accel::bvh::{self, lbvh, morton, Bvh, BvhNode, SplitMethod};
 use raylab_accel::{Accel, BuildOptions, Counters};
 use raylab_core::{Aabb, Ray, Vec3};
 use raylab_testkit::{bvh_shape as shape, Boxes};
@@ -39,21 +39,21 @@ fn interleave(x: u32, y: u32, z: u32) -> u32 {
 #[test]
 fn morton3_interleaves_the_bits_as_written_out() {
     // Every bit of one axis: 0b100 repeated ten times = 0x24924924, and shifted.
-    assert_eq!(lbvh::morton3(1023, 0, 0), 0x2492_4924);
-    assert_eq!(lbvh::morton3(0, 1023, 0), 0x1249_2492);
-    assert_eq!(lbvh::morton3(0, 0, 1023), 0x0924_9249);
-    assert_eq!(lbvh::morton3(1023, 1023, 1023), (1 << 30) - 1);
+    assert_eq!(morton::morton3(1023, 0, 0), 0x2492_4924);
+    assert_eq!(morton::morton3(0, 1023, 0), 0x1249_2492);
+    assert_eq!(morton::morton3(0, 0, 1023), 0x0924_9249);
+    assert_eq!(morton::morton3(1023, 1023, 1023), (1 << 30) - 1);
     // Single bits of each axis at each position, and mixed patterns in every bit.
     for k in 0..10 {
-        assert_eq!(lbvh::morton3(1 << k, 0, 0), 1 << (3 * k + 2), "x bit {k}");
-        assert_eq!(lbvh::morton3(0, 1 << k, 0), 1 << (3 * k + 1), "y bit {k}");
-        assert_eq!(lbvh::morton3(0, 0, 1 << k), 1 << (3 * k), "z bit {k}");
+        assert_eq!(morton::morton3(1 << k, 0, 0), 1 << (3 * k + 2), "x bit {k}");
+        assert_eq!(morton::morton3(0, 1 << k, 0), 1 << (3 * k + 1), "y bit {k}");
+        assert_eq!(morton::morton3(0, 0, 1 << k), 1 << (3 * k), "z bit {k}");
     }
     for (x, y, z) in [(0x2aa, 0x155, 0x3c3), (0x155, 0x2aa, 0x0f0), (1, 2, 3), (1000, 517, 99), (0x3ff, 0, 0x155)] {
-        assert_eq!(lbvh::morton3(x, y, z), interleave(x, y, z), "({x}, {y}, {z})");
+        assert_eq!(morton::morton3(x, y, z), interleave(x, y, z), "({x}, {y}, {z})");
     }
     // (x, y, z) = (5, 3, 6): x 101 -> bits 2, 8; y 011 -> bits 1, 4; z 110 -> bits 3, 6.
-    assert_eq!(lbvh::morton3(5, 3, 6), 4 + 256 + 2 + 16 + 8 + 64);
+    assert_eq!(morton::morton3(5, 3, 6), 4 + 256 + 2 + 16 + 8 + 64);
 }
 
 #[test]
@@ -61,18 +61,18 @@ fn morton_code_quantises_each_axis_in_its_own_extent() {
     // Extents 2, 4 and 8 (not 1, where `*` and `/` agree). (0.5, 3, 1) sits at 1/4, 3/4 and
     // 1/8 of them: 1024 cells give cells 256, 768 and 128.
     let b = aabb([0.0, 0.0, 0.0], [2.0, 4.0, 8.0]);
-    assert_eq!(lbvh::morton_code(Vec3::new(0.5, 3.0, 1.0), &b), interleave(256, 768, 128));
+    assert_eq!(morton::morton_code(Vec3::new(0.5, 3.0, 1.0), &b), interleave(256, 768, 128));
     // Offset bounds: the minimum maps to cell 0, the maximum to cell 1023 (clamped from 1024).
     let b = aabb([-3.0, 10.0, 5.0], [1.0, 12.0, 6.0]);
-    assert_eq!(lbvh::morton_code(Vec3::new(-3.0, 10.0, 5.0), &b), 0);
-    assert_eq!(lbvh::morton_code(Vec3::new(1.0, 12.0, 6.0), &b), (1 << 30) - 1);
+    assert_eq!(morton::morton_code(Vec3::new(-3.0, 10.0, 5.0), &b), 0);
+    assert_eq!(morton::morton_code(Vec3::new(1.0, 12.0, 6.0), &b), (1 << 30) - 1);
     // Half way on x, a quarter on y, the top cell on z: cells 512, 256, 1023.
-    assert_eq!(lbvh::morton_code(Vec3::new(-1.0, 10.5, 6.0), &b), interleave(512, 256, 1023));
+    assert_eq!(morton::morton_code(Vec3::new(-1.0, 10.5, 6.0), &b), interleave(512, 256, 1023));
     // Outside the bounds clamps to the end cells.
-    assert_eq!(lbvh::morton_code(Vec3::new(-100.0, 100.0, 5.5), &b), interleave(0, 1023, 512));
+    assert_eq!(morton::morton_code(Vec3::new(-100.0, 100.0, 5.5), &b), interleave(0, 1023, 512));
     // A flat axis maps to 0.
     let flat = aabb([0.0, 0.0, 0.0], [4.0, 0.0, 4.0]);
-    assert_eq!(lbvh::morton_code(Vec3::new(1.0, 0.0, 3.0), &flat), interleave(256, 0, 768));
+    assert_eq!(morton::morton_code(Vec3::new(1.0, 0.0, 3.0), &flat), interleave(256, 0, 768));
 }
 
 // ---------------------------------------------------------------- LBVH
@@ -496,6 +496,10 @@ fn validate_accepts_a_good_tree_and_rejects_each_broken_invariant() {
     // Primitive 1 in both leaves, 0 in none.
     let both = Bvh::from_parts(vec![root, leaf([0.0; 3], [3.0, 1.0, 1.0], 1, 1), l1], vec![0, 1], 2, "t");
     rejects(&both, &prims, "primitive 0 is in no leaf");
+    // Primitive 1 in two leaves and 0 in one: only spatial splits duplicate references.
+    let dup = Bvh::from_parts(vec![root, leaf([0.0; 3], [3.0, 1.0, 1.0], 0, 2), l1], vec![0, 1, 1], 2, "t");
+    rejects(&dup, &prims, "primitive 1 is in 2 leaves, not one");
+    dup.with_spatial_splits().validate(&prims).unwrap();
     // Children out of range (left 2: its sibling would be node 3), pointing back at the root
     // (left 0 <= 0), or sticking out.
     rejects(&Bvh::from_parts(vec![interior([0.0; 3], [3.0, 1.0, 1.0], 2), l0, l1], vec![0, 1], 2, "t"), &prims, "out of order or range");

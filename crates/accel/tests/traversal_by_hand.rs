@@ -226,22 +226,24 @@ fn binary_bvh_ties_go_left_first() {
 /// before the first is popped. The stack holds `MAX_DEPTH + 1` = 65 entries.
 ///
 /// Node `2k + 1` is the interior node at depth `k + 2` (its left child `2k + 3`), node
-/// `2k + 2` a leaf; every box is prim 0's flat square at c = 10, so every entry is t = 10 and
-/// ties take the left child (the chain) first. All 66 leaves are visited and tested (each
-/// hit is at t = 10 = t_max, within the closed interval): 65 interior + 66 leaf visits.
+/// `2k + 2` the leaf of prim k; the deepest node's two leaves hold prims 64 and 65. The 66
+/// prims are copies of one flat square at c = 10, so every entry is t = 10 and ties take the
+/// left child (the chain) first. All 66 leaves are visited and tested (each hit is at t = 10
+/// = t_max, within the closed interval, and replaces the last): 65 interior + 66 leaf
+/// visits, and the hit kept is the last leaf popped's, node 2's prim 0.
 #[test]
 fn binary_bvh_stack_holds_a_chain_66_deep() {
-    let soup = Soup::triangles([near_half(1, 10.0, -16.0, -16.0)]);
+    let soup = Soup::triangles([near_half(1, 10.0, -16.0, -16.0); 66]);
     let b = pb(&soup, 0);
     let mut nodes = vec![BvhNode::interior(b, 1)];
     for k in 0..64u32 {
         nodes.push(BvhNode::interior(b, 2 * k + 3));
-        nodes.push(BvhNode::leaf(b, 0, 1));
+        nodes.push(BvhNode::leaf(b, k, 1));
     }
-    nodes.push(BvhNode::leaf(b, 0, 1));
-    nodes.push(BvhNode::leaf(b, 0, 1));
+    nodes.push(BvhNode::leaf(b, 64, 1));
+    nodes.push(BvhNode::leaf(b, 65, 1));
     assert_eq!(nodes.len(), 131);
-    let bvh = Bvh::from_parts(nodes, vec![0], 1, "chain");
+    let bvh = Bvh::from_parts(nodes, (0..66).collect(), 66, "chain");
     bvh.validate(&soup).unwrap();
     assert_eq!(bvh.stats().max_depth, 66);
     let ray = axis_ray(1, 1.0, 0.0, -4.0, -2.0, f32::INFINITY);

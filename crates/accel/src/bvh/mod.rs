@@ -4,10 +4,13 @@
 //! Top-down builders (`build.rs`) differ only in where they split: binned SAH (Wald 2007),
 //! object median, spatial midpoint. Other builders produce the same nodes: `lbvh.rs`
 //! (Morton codes, Karras 2012), `ploc.rs` (Meister & Bittner 2018) and `sbvh.rs` (spatial
-//! splits, Stich et al. 2009).
+//! splits, Stich et al. 2009); the last two start from `morton.rs`' order. The walk,
+//! statistics and validation are the binary-tree code of `tree.rs`, shared with the sphere
+//! hierarchy; `traverse.rs` holds only the box test.
 
 mod build;
 pub mod lbvh;
+pub mod morton;
 mod node;
 pub mod ploc;
 mod sah;
@@ -19,6 +22,7 @@ pub use sah::SahCost;
 
 use raylab_core::Aabb;
 
+use crate::tree::{self, Containment};
 use crate::{AccelStats, BuildOptions, Primitives, ValidationError};
 
 /// Where a builder splits a node.
@@ -56,8 +60,7 @@ pub struct Bvh {
     pub(crate) spatial_splits: bool,
 }
 
-/// Trees deeper than this are cut into leaves: bounds the traversal stack.
-pub(crate) const MAX_DEPTH: usize = 64;
+pub(crate) use crate::tree::MAX_DEPTH;
 
 impl Bvh {
     pub fn build<P: Primitives + ?Sized>(prims: &P, method: SplitMethod, opts: &BuildOptions) -> Self {
@@ -90,68 +93,23 @@ impl Bvh {
             memory_bytes: self.nodes.len() * std::mem::size_of::<BvhNode>() + self.indices.len() * 4,
             ..Default::default()
         };
-        traverse::tree_stats(&self.nodes, &mut s, |n| n.bounds().half_area() as f64);
+        tree::tree_stats(&self.nodes, &mut s, |n| n.bounds().half_area() as f64);
         s
     }
 
     pub fn validate<P: Primitives + ?Sized>(&self, prims: &P) -> Result<(), ValidationError> {
-        let err = |m: String| Err(ValidationError::new(self.name, m));
-        if prims.len() != self.primitives {
-            return err(format!("built for {} primitives, given {}", self.primitives, prims.len()));
-        }
-        if self.nodes.is_empty() {
-            return if prims.is_empty() { Ok(()) } else { err("no nodes for a non-empty scene".into()) };
-        }
-        let mut seen = vec![0u32; prims.len()];
-        let mut reached = vec![false; self.nodes.len()];
-        let mut stack = vec![0usize];
-        while let Some(i) = stack.pop() {
-            if reached[i] {
-                return err(format!("node {i} reached twice"));
+        // With spatial splits a leaf bounds only the part of a primitive on its side of the
+        // planes above it (Stich et al. 2009), so the primitive may stick out; it must still
+        // touch the leaf, and may be in several. Without them it lies inside one leaf.
+        let leaf_holds = |i: usize, n: &BvhNode, p: u32| {
+            let (pb, b) = (prims.bounds(p), n.bounds());
+            match self.spatial_splits {
+                true if pb.intersection(b).is_empty() => Err(format!("primitive {p} does not touch leaf {i}")),
+                false if !b.contains_box(&pb) => Err(format!("primitive {p} sticks out of leaf {i}")),
+                _ => Ok(()),
             }
-            reached[i] = true;
-            let n = &self.nodes[i];
-            let b = n.bounds();
-            if n.is_leaf() {
-                let (first, count) = (n.left_first as usize, n.count as usize);
-                if first + count > self.indices.len() {
-                    return err(format!("leaf {i} points past the index array"));
-                }
-                for &p in &self.indices[first..first + count] {
-                    if p as usize >= prims.len() {
-                        return err(format!("leaf {i} holds primitive {p} of {}", prims.len()));
-                    }
-                    seen[p as usize] += 1;
-                    // With spatial splits a leaf bounds only the part of a primitive on its
-                    // side of the planes above it (Stich et al. 2009), so the primitive may
-                    // stick out; it must still touch the leaf. Without them it lies inside.
-                    let pb = prims.bounds(p);
-                    if self.spatial_splits && pb.intersection(b).is_empty() {
-                        return err(format!("primitive {p} does not touch leaf {i}"));
-                    }
-                    if !self.spatial_splits && !b.contains_box(&pb) {
-                        return err(format!("primitive {p} sticks out of leaf {i}"));
-                    }
-                }
-            } else {
-                let l = n.left_first as usize;
-                if l + 1 >= self.nodes.len() || l <= i {
-                    return err(format!("node {i} has children {l}, {} out of order or range", l + 1));
-                }
-                for c in [l, l + 1] {
-                    if !b.contains_box(&self.nodes[c].bounds()) {
-                        return err(format!("child {c} sticks out of node {i}"));
-                    }
-                    stack.push(c);
-                }
-            }
-        }
-        if let Some(i) = reached.iter().position(|r| !r) {
-            return err(format!("node {i} is unreachable"));
-        }
-        if let Some(p) = seen.iter().position(|&c| c == 0) {
-            return err(format!("primitive {p} is in no leaf"));
-        }
-        Ok(())
+        };
+        let child_inside = |n: &BvhNode, c: &BvhNode| n.bounds().contains_box(&c.bounds());
+        tree::validate_tree(self.name, &self.nodes, &self.indices, self.primitives, prims, Containment { child_inside, leaf_holds, each_once: !self.spatial_splits })
     }
 }

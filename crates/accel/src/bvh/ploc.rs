@@ -9,7 +9,8 @@
 use rayon::prelude::*;
 use raylab_core::{Aabb, Vec3};
 
-use super::lbvh::{self, morton_order, Tree, TreeNode, Volume};
+use super::lbvh::{self, Tree, TreeNode, Volume};
+use super::morton::morton_order;
 use super::Bvh;
 use crate::{BuildOptions, Primitives};
 
