@@ -20,7 +20,10 @@ pub fn rotation_minimising_normals(points: &[Vec3], tangents: &[Vec3]) -> Vec<Ve
         let (r, t) = (normals[i], tangents[i]);
         let v1 = points[i + 1] - points[i];
         let c1 = v1.length_squared();
-        let (r_l, t_l) = if c1 > 0.0 { (r - (2.0 / c1) * v1.dot(r) * v1, t - (2.0 / c1) * v1.dot(t) * v1) } else { (r, t) };
+        // Without a chord (a repeated sample) reflect in the plane normal to t, the limit of a
+        // vanishing chord: leaving the frame as it is would make the whole step one reflection,
+        // turning r half a turn about the next tangent more than the rotation does.
+        let (r_l, t_l) = if c1 > 0.0 { (r - (2.0 / c1) * v1.dot(r) * v1, t - (2.0 / c1) * v1.dot(t) * v1) } else { (r, -t) };
         let v2 = tangents[i + 1] - t_l;
         let c2 = v2.length_squared();
         let next = if c2 > 0.0 { r_l - (2.0 / c2) * v2.dot(r_l) * v2 } else { r_l };
@@ -230,6 +233,20 @@ mod tests {
         let normals = rotation_minimising_normals(&[p0, p0 + Vec3::X], &[Vec3::X, -Vec3::X]);
         assert!(near(normals[1], -Vec3::Z), "{normals:?}");
         assert!(rotation_minimising_normals(&[], &[]).is_empty());
+    }
+
+    #[test]
+    fn coincident_samples_turn_the_frame_like_a_vanishing_chord() {
+        // t turns from x̂ to ẑ. Over a short chord along t0 = x̂, v1 = εx̂: v1·r0 = 0, so r_L = r0 = −ẑ,
+        // t_L = −x̂; v2 = ẑ + x̂, c2 = 2, v2·r_L = −1, r1 = −ẑ + (1, 0, 1) = x̂: the quarter turn about
+        // −ŷ = t0 × t1 that takes x̂ to ẑ takes −ẑ to x̂. With no chord at all (a sample repeated,
+        // as at a zero-length segment) the frame must turn the same way, not by a reflection
+        // (which gives −x̂, a half turn about t1 more, twisting the tube between the two rings).
+        let p0 = Vec3::new(1.0, 2.0, 3.0);
+        for p1 in [p0 + Vec3::new(1e-3, 0.0, 0.0), p0] {
+            let normals = rotation_minimising_normals(&[p0, p1], &[Vec3::X, Vec3::Z]);
+            assert!(near(normals[1], Vec3::X), "{p1}: {normals:?}");
+        }
     }
 
     #[test]
