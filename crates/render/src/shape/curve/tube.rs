@@ -236,6 +236,28 @@ mod tests {
     }
 
     #[test]
+    fn on_a_helix_the_frame_turns_against_the_torsion() {
+        // The helix (a cos θ, a sin θ, bθ), a = 1, b = ½, has torsion τ = b/(a² + b²) and arc length
+        // s = θ√(a² + b²). A rotation-minimising normal r = cos φ N + sin φ B (N, B Frenet's) has
+        // r′ ∥ T only if φ′ = −τ (with N′ = −κT + τB, B′ = −τN), so φ falls by bθ/√(a² + b²).
+        let c = 1.25f32.sqrt();
+        let theta = |k: usize| 0.05 + 0.02 * k as f32;
+        let points: Vec<Vec3> = (0..150).map(|k| Vec3::new(theta(k).cos(), theta(k).sin(), 0.5 * theta(k))).collect();
+        let tangents: Vec<Vec3> = (0..150).map(|k| Vec3::new(-theta(k).sin(), theta(k).cos(), 0.5) / c).collect();
+        let normals = rotation_minimising_normals(&points, &tangents);
+        let phi = |k: usize| {
+            let (n, b) = (Vec3::new(-theta(k).cos(), -theta(k).sin(), 0.0), Vec3::new(0.5 * theta(k).sin(), -0.5 * theta(k).cos(), 1.0) / c);
+            normals[k].dot(b).atan2(normals[k].dot(n))
+        };
+        for k in 0..150 {
+            assert!((normals[k].length() - 1.0).abs() < 1e-5 && normals[k].dot(tangents[k]).abs() < 1e-5, "{k}: {}", normals[k]);
+            let want = -0.5 / c * (theta(k) - theta(0));
+            let off = (phi(k) - phi(0) - want + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU) - std::f32::consts::PI;
+            assert!(off.abs() < 1e-3, "{k}: turned {} vs {want}", phi(k) - phi(0));
+        }
+    }
+
+    #[test]
     fn coincident_samples_turn_the_frame_like_a_vanishing_chord() {
         // t turns from x̂ to ẑ. Over a short chord along t0 = x̂, v1 = εx̂: v1·r0 = 0, so r_L = r0 = −ẑ,
         // t_L = −x̂; v2 = ẑ + x̂, c2 = 2, v2·r_L = −1, r1 = −ẑ + (1, 0, 1) = x̂: the quarter turn about
