@@ -398,6 +398,10 @@ mod tests {
         let (o, d) = (DVec3::new(-0.5, -0.5, 4.0), DVec3::new(0.5, 1.0, -2.0));
         let (u, v, t) = newton(&p, o, d, (0.9, 0.1, 0.3), 1e-9).unwrap();
         assert!((u - 1.0 / 6.0).abs() < 1e-12 && (v - 0.5).abs() < 1e-12 && (t - 2.0).abs() < 1e-12, "{u} {v} {t}");
+        // Grazing, along (1, 0, −0.01) to (1.5, 1.5, 0) at t = 1.5: det = ∂P/∂u·(∂P/∂v × −d) = 3·(3·0.01)
+        // = 0.09, small against |∂P/∂u||∂P/∂v||d| ≈ 9 but far from singular (bound 9·10⁻¹²).
+        let (u, v, t) = newton(&p, DVec3::new(0.0, 1.5, 0.015), DVec3::new(1.0, 0.0, -0.01), (0.2, 0.7, 0.0), 1e-9).unwrap();
+        assert!((u - 0.5).abs() < 1e-12 && (v - 0.5).abs() < 1e-12 && (t - 1.5).abs() < 1e-9, "{u} {v} {t}");
         // A root within 10⁻⁹ outside the patch is clamped onto its edge; farther out it is refused.
         let down = DVec3::new(0.0, 0.0, -1.0);
         assert_eq!(newton(&p, DVec3::new(-1.5e-9, 1.5, 1.0), down, (0.5, 0.5, 0.0), 1e-9), Some((0.0, 0.5, 1.0)));
