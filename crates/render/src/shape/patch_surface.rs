@@ -256,6 +256,12 @@ mod tests {
         let (t_out, _, v_out) = s.intersect_patch(0, &Ray { t_min: t_in + 0.1, ..ray }).unwrap();
         assert!(t_out > t_in + 0.1 && v_out > 0.5, "{t_out} {v_out}");
         assert!(s.intersect_patch(0, &Ray { t_max: t_in * 0.9, ..ray }).is_none());
+        // The same line the other way, from y = 4: the dome is symmetric about y = 1.5 (v = ½), so
+        // the nearer hit is the mirror of the one above, t_in away again, and found after the
+        // farther one in the seed grid's row order.
+        let back = Ray::new(Vec3::new(1.0, 4.0, 0.3), -Vec3::Y);
+        let (t_back, _, v_back) = s.intersect_patch(0, &back).unwrap();
+        assert!((t_back - t_in).abs() < 1e-5 && (v_back - (1.0 - v_in)).abs() < 1e-5, "{t_back} {v_back} vs {t_in} {v_in}");
         // Beside the patch, and above it.
         assert!(s.intersect_patch(0, &Ray::new(Vec3::new(2.5, 1.5, 5.0), -Vec3::Z)).is_none());
         assert!(s.intersect_patch(0, &Ray::new(Vec3::new(-1.0, 1.5, 0.6), Vec3::X)).is_none());
