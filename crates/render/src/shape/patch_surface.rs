@@ -341,6 +341,20 @@ mod tests {
     }
 
     #[test]
+    fn newton_stops_relative_to_the_patch_size() {
+        // square(0) scaled by 10⁵: P(u, v) = (3u, 3v, 0)·10⁵. Newton stops within 10⁻⁹ × the size
+        // 3·10⁵ = 3·10⁻⁴; a fixed or inverse tolerance (10⁻⁹/size = 3·10⁻¹⁵) would sit below the f64
+        // rounding of coordinates near 10⁵ (about 10⁻¹¹) and never be met.
+        let mut big = square(0.0);
+        for q in &mut big.points {
+            *q *= 1e5;
+        }
+        let s = PatchSurfaces::new(vec![big], 2, MaterialId(0));
+        let (t, u, v) = s.intersect_patch(0, &Ray::new(Vec3::new(1e5, 2e5, 4e5), -Vec3::Z)).expect("a hit");
+        assert!((t - 4e5).abs() < 0.1 && (u - 1.0 / 3.0).abs() < 1e-6 && (v - 2.0 / 3.0).abs() < 1e-6, "{t} {u} {v}");
+    }
+
+    #[test]
     fn the_ray_interval_is_open_below_and_closed_above() {
         // Down onto z = 0 from z = 4: t = 4 exactly.
         let s = PatchSurfaces::new(vec![square(0.0)], 2, MaterialId(0));
