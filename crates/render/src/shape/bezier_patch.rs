@@ -268,4 +268,136 @@ mod tests {
         }
         assert_eq!(mesh.uvs[25 + 5 + 2], Vec2::new(0.5, 0.25));
     }
+
+    #[test]
+    fn size_is_the_largest_extent_of_the_control_net() {
+        // flat(): x in [0, 2], y in [0, 3], z = 0; moved to (5, −7, 9) the extents stay.
+        let mut p = flat();
+        assert_eq!(p.size(), 3.0);
+        for q in &mut p.points {
+            *q += Vec3::new(5.0, -7.0, 9.0);
+        }
+        assert_eq!(p.size(), 3.0);
+        // One point raised by 4.5: z then spans [9, 13.5].
+        p.points[7].z += 4.5;
+        assert_eq!(p.size(), 4.5);
+    }
+
+    #[test]
+    fn flat_patches_tessellated_by_hand() {
+        // Two subdivisions: vertices at u, v ∈ {0, ½, 1}, row by row in v, at (2u, 3v, 0) (the
+        // second patch moved up by 1 in z), normal ẑ, uv (u, v). Quad (i, j) has corners
+        // a = 3i + j, b = a + 1 (+u), d = a + 3 (+v), c = a + 4, split into [a, b, c] and [a, c, d].
+        let mut up = flat();
+        for q in &mut up.points {
+            q.z = 1.0;
+        }
+        let mesh = tessellate(&[flat(), up], 2);
+        assert_eq!(mesh.name, "bezier patches");
+        assert_eq!(mesh.positions.len(), 18);
+        for (k, (p, (n, uv))) in mesh.positions.iter().zip(mesh.normals.iter().zip(&mesh.uvs)).enumerate() {
+            let (u, v) = ((k % 3) as f32 / 2.0, (k % 9 / 3) as f32 / 2.0);
+            let z = if k < 9 { 0.0 } else { 1.0 };
+            assert!(close(*p, Vec3::new(2.0 * u, 3.0 * v, z)) && close(*n, Vec3::Z) && *uv == Vec2::new(u, v), "vertex {k}: {p} {n} {uv}");
+        }
+        let first: [[u32; 3]; 8] = [[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4], [3, 4, 7], [3, 7, 6], [4, 5, 8], [4, 8, 7]];
+        let second = first.map(|t| t.map(|k| k + 9));
+        assert_eq!(mesh.indices, [first, second].concat());
+        // [0, 1, 4]: (1, 0, 0) × (1, 1.5, 0) = (0, 0, 1.5), along ∂P/∂u × ∂P/∂v = (2, 0, 0) × (0, 3, 0).
+        assert!(close(mesh.winding_normal(0), Vec3::Z));
+    }
+
+    #[test]
+    fn degenerate_means_area_within_a_millionth_of_the_longest_edge_squared() {
+        // |(b − a) × (c − a)| = twice the area = L·h for the longest edge L = 1000 and the
+        // height h over it; degenerate when L·h ≤ 10⁻⁶ L², that is h ≤ 10⁻³. Far from the
+        // origin (1000, 1000, 1000), and with the longest edge first, second or third.
+        let a = Vec3::splat(1000.0);
+        let b = a + Vec3::new(1000.0, 0.0, 0.0);
+        for (h, degenerate) in [(1.5e-3, false), (0.5e-3, true)] {
+            let c = Vec3::new(1500.0, 1000.0 + h, 1000.0);
+            assert_eq!([is_degenerate([a, b, c]), is_degenerate([b, c, a]), is_degenerate([c, a, b])], [degenerate; 3], "h = {h}");
+        }
+        assert!(is_degenerate([a, a, a]) && is_degenerate([a, b, b]));
+        assert!(!is_degenerate([Vec3::ZERO, Vec3::X, Vec3::Y]));
+    }
+
+    #[test]
+    fn collapsed_edges_on_all_four_sides_have_the_cone_normal() {
+        // cone() is P(u, v) = v·(C(u), −1) + ẑ, C the planar Bézier arc over (cos, sin)(kπ/6):
+        // ∂P/∂u = v·(C′, 0) vanishes at v = 0, ∂P/∂v = (C, −1), ∂²P/∂u∂v = (C′, 0). At u = 0,
+        // C = (1, 0) and C′ = 3((√3/2, ½) − (1, 0)), so the normal is along
+        // (C′, 0) × (1, 0, −1) = (−C′y, C′x, −C′y).
+        let c = 3.0 * (Vec3::new(0.75f32.sqrt(), 0.5, 0.0) - Vec3::X);
+        let n = Vec3::new(-c.y, c.x, -c.y).normalize();
+        let p = cone().points;
+        // Rows reversed, P(u, 1 − v): the pole at v = 1, the surface turned over (−n). Transposed,
+        // P(v, u): the pole at u = 0, turned over too. Transposed and reversed, P(v, 1 − u): the
+        // pole at u = 1, −1 twice, n.
+        let reversed = BezierPatch { points: std::array::from_fn(|k| p[4 * (3 - k / 4) + k % 4]) };
+        let transposed = BezierPatch { points: std::array::from_fn(|k| p[4 * (k % 4) + k / 4]) };
+        let both = BezierPatch { points: std::array::from_fn(|k| p[4 * (3 - k % 4) + k / 4]) };
+        for (patch, (u, v), want) in [(cone(), (0.0, 0.0), n), (reversed, (0.0, 1.0), -n), (transposed, (0.0, 0.0), -n), (both, (1.0, 0.0), n)] {
+            let got = patch.normal(u, v);
+            assert!(close(got, want), "({u}, {v}): {got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn vanishing_is_relative_to_the_patch_size() {
+        // cone() scaled by 10 with its apex moved to the origin, and its pole row spread along ẑ by
+        // 10⁻⁹ per point: ∂P/∂u = (0, 0, 3·10⁻⁹) at v = 0, under 10⁻⁹ × the size 10. It counts as
+        // vanished, and the normal at the pole is the cone's (as above, scale-free); taken at face
+        // value, (0, 0, 1) × ∂P/∂v = ẑ × (10, 0, −10) would give ŷ.
+        let mut p = cone();
+        for q in &mut p.points {
+            *q = 10.0 * (*q - Vec3::Z);
+        }
+        for k in 0..4 {
+            p.points[k] = Vec3::new(0.0, 0.0, 1e-9 * k as f32);
+        }
+        assert_eq!(p.size(), 10.0);
+        let c = 3.0 * (Vec3::new(0.75f32.sqrt(), 0.5, 0.0) - Vec3::X);
+        let want = Vec3::new(-c.y, c.x, -c.y).normalize();
+        assert!(close(p.normal(0.0, 0.0), want), "{}", p.normal(0.0, 0.0));
+        // A dome a tenth the size: |∂P/∂u × ∂P/∂v| = 0.06 is under |∂P/∂v| = 0.3, yet far from
+        // vanishing against |∂P/∂u||∂P/∂v|; the normal is the dome's at (0.25, 0.5) exactly.
+        let mut small = dome();
+        for q in &mut small.points {
+            *q *= 0.1;
+        }
+        let want = Vec3::new(2.0, 0.0, 1.125).cross(Vec3::new(0.0, 3.0, 0.0)).normalize();
+        assert!(close(small.normal(0.25, 0.5), want), "{}", small.normal(0.25, 0.5));
+    }
+
+    #[test]
+    fn a_corner_where_even_the_mixed_derivative_vanishes_steps_inside() {
+        // Points 0, 1, 4 and 5 together: ∂P/∂u = 3(p1 − p0), ∂P/∂v = 3(p4 − p0) and
+        // ∂²P/∂u∂v = 9(p5 − p4 − p1 + p0) all vanish at (0, 0), the cross product is 0 against a
+        // bound of 0: a unit normal from a step inside, not 0/0.
+        let mut p = dome();
+        for k in [0, 1, 4, 5] {
+            p.points[k] = Vec3::ZERO;
+        }
+        let n = p.normal(0.0, 0.0);
+        assert!(n.is_finite() && (n.length() - 1.0).abs() < 1e-6 && n.dot(p.normal(0.01, 0.01)) > 0.9, "{n}");
+    }
+
+    #[test]
+    fn corner_normal_is_the_limit_a_step_inside() {
+        // Row 0 and column 0 at the origin: near (0, 0) only B1 B1 p5, B2(u) B1(v) p6 and
+        // B1(u) B2(v) p9 count, P ≈ 9uv p5 + 9u²v (p6 − 2p5) + 9uv² (p9 − 2p5), and at u = v = ε
+        // ∂P/∂u × ∂P/∂v ≈ 81ε³ p5 × (p9 − p6) = 81ε³ (2/3, 1, 1) × (−2/3, 1, 0) = 81ε³ (−1, −2/3, 4/3),
+        // along (−3, −2, 4)/√29. The step of 10⁻³ towards the centre lands at ε = 5·10⁻⁴, where the
+        // neglected terms tilt it by about 4·10⁻⁴ rad (cos ≥ 1 − 10⁻⁷).
+        let mut p = dome();
+        for k in [0, 1, 2, 3, 4, 8, 12] {
+            p.points[k] = Vec3::ZERO;
+        }
+        let want = Vec3::new(-3.0, -2.0, 4.0) / 29f32.sqrt();
+        assert!(p.normal(0.0, 0.0).dot(want) > 0.9999995, "{}", p.normal(0.0, 0.0));
+        // Turned round, P(1 − u, 1 − v): the corner at (1, 1), the same normal (−1 twice).
+        let turned = BezierPatch { points: std::array::from_fn(|k| p.points[15 - k]) };
+        assert!(turned.normal(1.0, 1.0).dot(want) > 0.9999995, "{}", turned.normal(1.0, 1.0));
+    }
 }

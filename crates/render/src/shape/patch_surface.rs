@@ -256,8 +256,186 @@ mod tests {
         let (t_out, _, v_out) = s.intersect_patch(0, &Ray { t_min: t_in + 0.1, ..ray }).unwrap();
         assert!(t_out > t_in + 0.1 && v_out > 0.5, "{t_out} {v_out}");
         assert!(s.intersect_patch(0, &Ray { t_max: t_in * 0.9, ..ray }).is_none());
+        // The same line the other way, from y = 4: the dome is symmetric about y = 1.5 (v = ½), so
+        // the nearer hit is the mirror of the one above, t_in away again, and found after the
+        // farther one in the seed grid's row order.
+        let back = Ray::new(Vec3::new(1.0, 4.0, 0.3), -Vec3::Y);
+        let (t_back, _, v_back) = s.intersect_patch(0, &back).unwrap();
+        assert!((t_back - t_in).abs() < 1e-5 && (v_back - (1.0 - v_in)).abs() < 1e-5, "{t_back} {v_back} vs {t_in} {v_in}");
         // Beside the patch, and above it.
         assert!(s.intersect_patch(0, &Ray::new(Vec3::new(2.5, 1.5, 5.0), -Vec3::Z)).is_none());
         assert!(s.intersect_patch(0, &Ray::new(Vec3::new(-1.0, 1.5, 0.6), Vec3::X)).is_none());
+    }
+
+    /// The plane z = `z` as a patch with exact control points (col, row, z): P(u, v) = (3u, 3v, z),
+    /// cubic Bernstein weights reproducing linear functions.
+    fn square(z: f32) -> BezierPatch {
+        BezierPatch { points: std::array::from_fn(|k| Vec3::new((k % 4) as f32, (k / 4) as f32, z)) }
+    }
+
+    fn close(a: Vec3, b: Vec3, eps: f32) -> bool {
+        (a - b).abs().max_element() < eps
+    }
+
+    #[test]
+    fn counts_memory_bounds_and_surface_by_hand() {
+        let mut moved = dome();
+        for q in &mut moved.points {
+            q.x += 5.0;
+        }
+        let s = PatchSurfaces::new(vec![dome(), moved], 2, MaterialId(4));
+        assert_eq!((s.len(), Primitives::len(&s), s.is_empty(), s.material), (2, 2, false, MaterialId(4)));
+        assert!(PatchSurfaces::new(Vec::new(), 2, MaterialId(0)).is_empty());
+        assert_eq!(s.patch(1), &moved);
+        // Per patch: 16 points of 12 bytes, (2 + 1)² seeds of 24, 4 quad and 1 block boxes of 48.
+        assert_eq!(s.memory_bytes(), 2 * (16 * 12 + 9 * 24 + 5 * 48));
+        // 5 quads a side make 2 × 2 blocks of up to 4 × 4: 36 seeds, 25 + 4 boxes.
+        assert_eq!(PatchSurfaces::new(vec![dome()], 5, MaterialId(0)).memory_bytes(), 16 * 12 + 36 * 24 + 29 * 48);
+        let b = s.bounds(1);
+        assert_eq!((b.min, b.max), (Vec3::new(5.0, 0.0, 0.0), Vec3::new(7.0, 3.0, 1.0)));
+        // At (0.25, 0.5) of the moved dome: p = (5.5, 1.5, (36/64)(0.75)), ∂p/∂u = (2, 0, (24/16)(0.75)),
+        // ∂p/∂v = (0, 3, (36/64)(B1′ + B2′)(½) = 0); n ∝ (2, 0, 1.125) × (0, 3, 0) = (−3.375, 0, 6).
+        // The error: γ₈|p| + 10⁻⁶ × the control net's size 3, γ₈ = 8(ε/2)/(1 − 8(ε/2)).
+        let g = s.surface(1, 0.25, 0.5);
+        let n = Vec3::new(-3.375, 0.0, 6.0).normalize();
+        assert!(close(g.p, Vec3::new(5.5, 1.5, 0.421875), 1e-6) && close(g.dpdu, Vec3::new(2.0, 0.0, 1.125), 1e-6) && close(g.dpdv, Vec3::new(0.0, 3.0, 0.0), 1e-6), "{g:?}");
+        assert!(close(g.ng, n, 1e-6) && close(g.ns, n, 1e-6) && g.uv == Vec2::new(0.25, 0.5), "{g:?}");
+        let gamma8 = 8.0 * f64::from(f32::EPSILON) / 2.0 / (1.0 - 8.0 * f64::from(f32::EPSILON) / 2.0);
+        let want = [5.5, 1.5, 0.421875].map(|c: f64| (gamma8 * c + 3e-6) as f32);
+        assert!(close(g.p_error, Vec3::from(want), 1e-9), "{} vs {want:?}", g.p_error);
+        // The trait's hit is intersect_patch's.
+        let ray = Ray::new(Vec3::new(5.5, 1.5, 5.0), -Vec3::Z);
+        let (t, u, v) = s.intersect_patch(1, &ray).unwrap();
+        assert_eq!(Primitives::intersect(&s, 1, &ray), Some(PrimHit { t, u, v }));
+        assert!((t - (5.0 - 0.421875)).abs() < 1e-6 && (u - 0.25).abs() < 1e-6 && (v - 0.5).abs() < 1e-6);
+        assert!(Primitives::intersect(&s, 0, &ray).is_none());
+    }
+
+    #[test]
+    fn hits_all_over_a_plane_patch_by_hand() {
+        // P(u, v) = (3u, 3v, z): a ray from o along d meets it at t = (z − o.z)/d.z, u = x/3, v = y/3.
+        // Seed grids of 1, 5 and 8 quads (culling blocks of 4 × 4: one, 2 × 2 with partial ones, 2 × 2),
+        // three patches so that patch 2's seeds and boxes are found at their offsets, rays straight down
+        // and slanted, to every cell of a 12 × 12 grid of points and to the corners.
+        for grid in [1, 5, 8] {
+            let s = PatchSurfaces::new(vec![square(0.0), square(-1.0), square(2.0)], grid, MaterialId(0));
+            for (i, z) in [(0, 0.0f32), (1, -1.0), (2, 2.0)] {
+                for k in 0..=12 {
+                    for l in 0..=12 {
+                        let (x, y) = (0.25 * k as f32, 0.25 * l as f32);
+                        for d in [Vec3::new(0.0, 0.0, -1.0), Vec3::new(0.5, -0.25, -2.0)] {
+                            let o = Vec3::new(x, y, z) - 2.0 * d;
+                            let hit = s.intersect_patch(i, &Ray::new(o, d));
+                            let Some((t, u, v)) = hit else { panic!("grid {grid} patch {i} ({x}, {y}) along {d}: missed") };
+                            assert!((t - 2.0).abs() < 1e-5 && (u - x / 3.0).abs() < 1e-5 && (v - y / 3.0).abs() < 1e-5, "grid {grid} patch {i} ({x}, {y}): {t} {u} {v}");
+                        }
+                    }
+                }
+                // Beside it, just off each edge, and pointing away from it.
+                for (x, y) in [(-0.1, 1.5), (3.1, 1.5), (1.5, -0.1), (1.5, 3.1)] {
+                    assert!(s.intersect_patch(i, &Ray::new(Vec3::new(x, y, z + 1.0), -Vec3::Z)).is_none(), "grid {grid} ({x}, {y})");
+                }
+                assert!(s.intersect_patch(i, &Ray::new(Vec3::new(1.5, 1.5, z + 1.0), Vec3::Z)).is_none());
+            }
+        }
+    }
+
+    #[test]
+    fn newton_stops_relative_to_the_patch_size() {
+        // square(0) scaled by 10⁵: P(u, v) = (3u, 3v, 0)·10⁵. Newton stops within 10⁻⁹ × the size
+        // 3·10⁵ = 3·10⁻⁴; a fixed or inverse tolerance (10⁻⁹/size = 3·10⁻¹⁵) would sit below the f64
+        // rounding of coordinates near 10⁵ (about 10⁻¹¹) and never be met.
+        let mut big = square(0.0);
+        for q in &mut big.points {
+            *q *= 1e5;
+        }
+        let s = PatchSurfaces::new(vec![big], 2, MaterialId(0));
+        let (t, u, v) = s.intersect_patch(0, &Ray::new(Vec3::new(1e5, 2e5, 4e5), -Vec3::Z)).expect("a hit");
+        assert!((t - 4e5).abs() < 0.1 && (u - 1.0 / 3.0).abs() < 1e-6 && (v - 2.0 / 3.0).abs() < 1e-6, "{t} {u} {v}");
+    }
+
+    #[test]
+    fn the_ray_interval_is_open_below_and_closed_above() {
+        // Down onto z = 0 from z = 4: t = 4 exactly.
+        let s = PatchSurfaces::new(vec![square(0.0)], 2, MaterialId(0));
+        let ray = |t_min, t_max| Ray::segment(Vec3::new(1.0, 2.0, 4.0), -Vec3::Z, t_min, t_max);
+        assert_eq!(s.intersect_patch(0, &ray(0.0, 4.0)), Some((4.0, 1.0 / 3.0, 2.0 / 3.0)));
+        assert_eq!(s.intersect_patch(0, &ray(3.0, f32::INFINITY)).map(|h| h.0), Some(4.0));
+        assert!(s.intersect_patch(0, &ray(4.0, 10.0)).is_none() && s.intersect_patch(0, &ray(0.0, 3.99)).is_none());
+        // Two sheets, z = 0 and z = 2, each hit through its own seeds, from above and from below.
+        let s = PatchSurfaces::new(vec![square(0.0), square(2.0)], 2, MaterialId(0));
+        for (o, d, want) in [(4.0, -1.0, [4.0, 2.0]), (-1.0, 1.0, [1.0, 3.0])] {
+            for i in 0..2 {
+                let t = s.intersect_patch(i, &Ray::new(Vec3::new(1.5, 1.5, o), Vec3::new(0.0, 0.0, d))).unwrap().0;
+                assert_eq!(t, want[i as usize]);
+            }
+        }
+    }
+
+    #[test]
+    fn line_meets_box_by_hand() {
+        // The box [0, 1] × [0, 2] × [0, 3]; a line o + t·d for any t.
+        let b = (DVec3::ZERO, DVec3::new(1.0, 2.0, 3.0));
+        let meets = |o: [f64; 3], d: [f64; 3]| line_meets_box(DVec3::from(o), DVec3::from(d).recip(), &b);
+        // Along x through the inside, and the same line from beyond the box, pointing away.
+        assert!(meets([-1.0, 1.0, 1.0], [1.0, 0.0, 0.0]) && meets([2.0, 1.0, 1.0], [1.0, 0.0, 0.0]));
+        // Parallel to x: inside the y and z slabs (on their faces too), or outside one.
+        assert!(meets([-1.0, 0.0, 3.0], [1.0, 0.0, 0.0]) && meets([-1.0, 2.0, 0.0], [1.0, 0.0, 0.0]));
+        assert!(!meets([-1.0, -0.1, 1.0], [1.0, 0.0, 0.0]) && !meets([-1.0, 2.1, 1.0], [1.0, 0.0, 0.0]) && !meets([-1.0, 1.0, 3.1], [1.0, 0.0, 0.0]));
+        // Slanted in x and y at z = 1: from (0, 3) along (1, −1) the x slab is t ∈ [0, 1] and the
+        // y slab t ∈ [1, 3]: they touch at t = 1, the corner (1, 2). From (0, 3.5): t ∈ [0, 1] and
+        // [1.5, 3.5], apart. From (−1, −1) along (1, 1): [1, 2] and [1, 3], overlapping.
+        assert!(meets([0.0, 3.0, 1.0], [1.0, -1.0, 0.0]) && !meets([0.0, 3.5, 1.0], [1.0, -1.0, 0.0]) && meets([-1.0, -1.0, 1.0], [1.0, 1.0, 0.0]));
+        // Along (2, −1, 4) from (−2, 3, −4): x slab t ∈ [1, 1.5], y slab [1, 3], z slab [1, 1.75].
+        assert!(meets([-2.0, 3.0, -4.0], [2.0, -1.0, 4.0]));
+        // The z slab moved to t ∈ [1.6, 2.35] by starting at z = −6.4: apart from the x slab.
+        assert!(!meets([-2.0, 3.0, -6.4], [2.0, -1.0, 4.0]));
+    }
+
+    #[test]
+    fn plane_hit_by_hand() {
+        // The triangle (1, 1, 1), (3, 1, 1), (1, 3, 1): e1 = (2, 0, 0), e2 = (0, 2, 0); a ray down from
+        // z = 5 with |d| = 2 meets its plane at t = 2, with b1 = (x − 1)/2 and b2 = (y − 1)/2.
+        let tri = [DVec3::new(1.0, 1.0, 1.0), DVec3::new(3.0, 1.0, 1.0), DVec3::new(1.0, 3.0, 1.0)];
+        let hit = |x: f64, y: f64| plane_hit(DVec3::new(x, y, 5.0), DVec3::new(0.0, 0.0, -2.0), tri);
+        assert_eq!(hit(1.5, 2.0), Some((2.0, 0.25, 0.5)));
+        // Each barycentric may reach −½ (SEED_SLACK), not beyond.
+        assert_eq!(hit(0.0, 2.0), Some((2.0, -0.5, 0.5)));
+        assert_eq!(hit(2.0, 0.0), Some((2.0, 0.5, -0.5)));
+        assert_eq!(hit(2.5, 2.5), Some((2.0, 0.75, 0.75)));
+        assert_eq!([hit(-0.5, 2.0), hit(2.0, -0.5), hit(2.75, 2.75)], [None; 3]);
+        // Upwards from below, t = −2 (the plane behind the origin still seeds), and parallel to it.
+        assert_eq!(plane_hit(DVec3::new(1.5, 2.0, 5.0), DVec3::new(0.0, 0.0, 2.0), tri), Some((-2.0, 0.25, 0.5)));
+        assert_eq!(plane_hit(DVec3::new(1.5, 2.0, 5.0), DVec3::new(1.0, 1.0, 0.0), tri), None);
+    }
+
+    #[test]
+    fn newton_by_hand() {
+        // On P(u, v) = (3u, 3v, 0) the system is linear: one step from anywhere reaches the root.
+        // The ray from (−0.5, −0.5, 4) along (0.5, 1, −2) meets z = 0 at t = 2, (0.5, 1.5, 0):
+        // u = 1/6, v = ½.
+        let p = square(0.0);
+        let (o, d) = (DVec3::new(-0.5, -0.5, 4.0), DVec3::new(0.5, 1.0, -2.0));
+        let (u, v, t) = newton(&p, o, d, (0.9, 0.1, 0.3), 1e-9).unwrap();
+        assert!((u - 1.0 / 6.0).abs() < 1e-12 && (v - 0.5).abs() < 1e-12 && (t - 2.0).abs() < 1e-12, "{u} {v} {t}");
+        // Grazing, along (1, 0, −0.01) to (1.5, 1.5, 0) at t = 1.5: det = ∂P/∂u·(∂P/∂v × −d) = 3·(3·0.01)
+        // = 0.09, small against |∂P/∂u||∂P/∂v||d| ≈ 9 but far from singular (bound 9·10⁻¹²).
+        let (u, v, t) = newton(&p, DVec3::new(0.0, 1.5, 0.015), DVec3::new(1.0, 0.0, -0.01), (0.2, 0.7, 0.0), 1e-9).unwrap();
+        assert!((u - 0.5).abs() < 1e-12 && (v - 0.5).abs() < 1e-12 && (t - 1.5).abs() < 1e-9, "{u} {v} {t}");
+        // A root within 10⁻⁹ outside the patch is clamped onto its edge; farther out it is refused.
+        let down = DVec3::new(0.0, 0.0, -1.0);
+        assert_eq!(newton(&p, DVec3::new(-1.5e-9, 1.5, 1.0), down, (0.5, 0.5, 0.0), 1e-9), Some((0.0, 0.5, 1.0)));
+        assert_eq!(newton(&p, DVec3::new(1.5, 3.0 + 1.5e-9, 1.0), down, (0.5, 0.5, 0.0), 1e-9), Some((0.5, 1.0, 1.0)));
+        assert_eq!(newton(&p, DVec3::new(-6e-9, 1.5, 1.0), down, (0.5, 0.5, 0.0), 1e-9), None);
+        assert_eq!(newton(&p, DVec3::new(1.5, 3.0 + 6e-9, 1.0), down, (0.5, 0.5, 0.0), 1e-9), None);
+        // A root at u = 1.5 (x = 4.5): outside, though within the wandering range [−1, 2].
+        assert_eq!(newton(&p, DVec3::new(4.5, 1.5, 1.0), down, (0.5, 0.5, 0.0), 1e-9), None);
+        // Already at the root: no step. Parallel to the plane: a singular Jacobian, no root.
+        assert_eq!(newton(&p, DVec3::new(1.5, 1.5, 1.0), down, (0.5, 0.5, 1.0), 1e-9), Some((0.5, 0.5, 1.0)));
+        assert_eq!(newton(&p, DVec3::new(0.0, 1.5, 0.0), DVec3::X, (0.5, 0.5, 0.0), 1e-9), None);
+        // The dome z = (B1 + B2)(u)(B1 + B2)(v) over (2u, v·3): from its top, straight down.
+        let (u, v, t) = newton(&dome(), DVec3::new(1.0, 1.5, 5.0), down, (0.4, 0.6, 4.0), 1e-9).unwrap();
+        // (Its control points' x, 2k/3 rounded to f32, put the top 10⁻⁸ off u = ½, where z is flat.)
+        assert!((u - 0.5).abs() < 1e-7 && (v - 0.5).abs() < 1e-9 && (t - (5.0 - 0.5625)).abs() < 1e-9, "{u} {v} {t}");
     }
 }
