@@ -640,4 +640,35 @@ mod tests {
         }
         assert!(checked > 500, "{checked}");
     }
+
+    /// From inside, the exit root when the entry behind the origin lies at the leaf's middle
+    /// depth (its constant term ≈ 0): the tube of radius ¼ along x entered at P = (0.5, ¼, 0)
+    /// along d = (0.5, -1, 0.3), P ⟂ d, so that P is the ray's point at the depth of the
+    /// segment's middle (the origin). The exit, the larger root of
+    /// (P.y + t·d.y)² + (P.z + t·d.z)² = r² (t from P), in f64.
+    #[test]
+    fn the_exit_from_inside_when_the_entry_is_at_the_middle_depth() {
+        let (p, d) = ([0.5f64, 0.25, 0.0], [0.5f64, -1.0, 0.3]);
+        let a = d[1] * d[1] + d[2] * d[2];
+        let b = 2.0 * (p[1] * d[1] + p[2] * d[2]);
+        let c = p[1] * p[1] + p[2] * p[2] - 0.0625;
+        let t = (-b + (b * b - 4.0 * a * c).sqrt()) / (2.0 * a);
+        assert!((p[0] + t * d[0]).abs() < 0.9 && c == 0.0, "{t}");
+        // From P + 0.1·d, inside.
+        let o = Vec3::new(0.55, 0.15, 0.03);
+        let hit = intersect(&straight(0.25, 0.25), 0, [None, None], &Ray::new(o, Vec3::new(0.5, -1.0, 0.3))).unwrap();
+        assert!((f64::from(hit.t) - (t - 0.1)).abs() < 1e-5, "{hit:?} vs {}", t - 0.1);
+    }
+
+    /// A V of two leaves (depth 1, chords (-1, 0, 0) to (0, 1, 0) to (1, 0, 0)) fatter than
+    /// its chords are long, radius 1.2: from the apex straight down, the ray leaves both
+    /// cylinders at once at their inner crease, y = 1 - 1.2·√2 (distance 1.2 from both axes
+    /// y = ±x + 1, outside the spheres at (±1, 0, 0): √(1 + 0.697²) > 1.2), t = 1.2·√2. A point
+    /// on both frusta is on the tube's surface, inside neither.
+    #[test]
+    fn a_fat_v_is_left_at_its_inner_crease() {
+        let cp = [Vec4::new(-1.0, 0.0, 0.0, 1.2), Vec4::new(0.0, 4.0 / 3.0, 0.0, 1.2), Vec4::new(0.0, 4.0 / 3.0, 0.0, 1.2), Vec4::new(1.0, 0.0, 0.0, 1.2)];
+        let hit = intersect(&cp, 1, [None, None], &Ray::new(Vec3::new(0.0, 1.0, 0.0), -Vec3::Y)).unwrap();
+        assert!((f64::from(hit.t) - 1.2 * 2f64.sqrt()).abs() < 1e-5, "{hit:?}");
+    }
 }
