@@ -91,15 +91,15 @@ struct Leaf {
 }
 
 impl Leaf {
-    /// Whether `p` is inside the tube by more than `delta`, judged on the pieces other
-    /// than `own` that can reach it: the end spheres, this frustum, the neighbours' frusta.
+    /// Whether `p` is inside the tube by more than `delta`, judged on the pieces other than `own` that can
+    /// reach it: the end spheres, this frustum, the neighbours' frusta and far-end spheres (those reach back).
     fn interior(&self, p: Vec3, own: Piece) -> bool {
         let d = self.delta;
         (own != Piece::SphereA && in_sphere(p, self.a, d))
             || (own != Piece::SphereB && in_sphere(p, self.b, d))
             || (own != Piece::Frustum && in_frustum(p, self.a, self.b, d))
-            || self.before.is_some_and(|e| in_frustum(p, self.a, e, d))
-            || self.after.is_some_and(|e| in_frustum(p, self.b, e, d))
+            || self.before.is_some_and(|e| in_frustum(p, self.a, e, d) || in_sphere(p, e, d))
+            || self.after.is_some_and(|e| in_frustum(p, self.b, e, d) || in_sphere(p, e, d))
     }
 }
 
@@ -579,7 +579,7 @@ mod tests {
 
     /// Strands whose leaves meet at a sharp angle or taper steeply (a V cut into 2 and 4
     /// leaves, two segments meeting at 53°, a short leaf with overlapping end spheres, a
-    /// cone from radius 0.6 to 0.1 over 0.8): rays from inside, near each leaf's ends and
+    /// cone from radius 0.6 to 0.1 over 0.8, a radius tripling over 0.1): rays from inside, near each leaf's ends and
     /// middle, and from outside, against the first crossing of the union of the pieces
     /// computed by marching in f64. From inside that is the tube's surface, never a piece
     /// inside another (a frustum's side within the next one at the inner side of a bend, a
@@ -595,6 +595,7 @@ mod tests {
             vec![(line(Vec4::new(-1.0, 0.0, 0.0, 0.3), Vec4::new(0.0, 0.0, 0.0, 0.2)), 0), (line(Vec4::new(0.0, 0.0, 0.0, 0.2), Vec4::new(0.6, 0.8, 0.0, 0.1)), 0)],
             vec![(line(Vec4::new(-0.1, 0.0, 0.0, 0.25), Vec4::new(0.1, 0.0, 0.0, 0.25)), 0)],
             vec![(line(Vec4::new(-0.4, 0.0, 0.0, 0.6), Vec4::new(0.4, 0.0, 0.0, 0.1)), 0)],
+            vec![(line(Vec4::new(-1.0, 0.0, 0.0, 0.1), Vec4::new(0.0, 0.0, 0.0, 0.1)), 0), (line(Vec4::new(0.0, 0.0, 0.0, 0.1), Vec4::new(0.1, 0.0, 0.0, 0.3)), 0)],
         ];
         let dirs = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.3, 0.8, 0.2], [-0.7, 0.4, 0.5], [0.5, -0.6, -0.3], [-0.2, -0.9, 0.6], [0.9, 0.3, -0.4], [-0.6, -0.2, -0.8]];
         let mut checked = 0;
@@ -670,5 +671,22 @@ mod tests {
         let cp = [Vec4::new(-1.0, 0.0, 0.0, 1.2), Vec4::new(0.0, 4.0 / 3.0, 0.0, 1.2), Vec4::new(0.0, 4.0 / 3.0, 0.0, 1.2), Vec4::new(1.0, 0.0, 0.0, 1.2)];
         let hit = intersect(&cp, 1, [None, None], &Ray::new(Vec3::new(0.0, 1.0, 0.0), -Vec3::Y)).unwrap();
         assert!((f64::from(hit.t) - 1.2 * 2f64.sqrt()).abs() < 1e-5, "{hit:?}");
+    }
+
+    /// A radius that triples over a short segment (0.1 at x = 0 to 0.3 at x = 0.1, after a
+    /// segment of radius 0.1 from x = -1): the next segment's far-end sphere (centre
+    /// (0.1, 0, 0), radius 0.3) reaches back over the joint and covers the first segment's
+    /// side for x > 0.1 - √0.08. From (-0.1, 0, 0) up y, the first segment's side y = 0.1 is
+    /// inside it (0.2² + 0.1² < 0.3²): the ray leaves the tube through that sphere, at
+    /// y = √(0.3² - 0.2²).
+    #[test]
+    fn a_neighbours_far_end_sphere_covers_the_joint() {
+        let line = |a: Vec4, b: Vec4| [0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0].map(|s| a.lerp(b, s));
+        let first = line(Vec4::new(-1.0, 0.0, 0.0, 0.1), Vec4::new(0.0, 0.0, 0.0, 0.1));
+        let next = line(Vec4::new(0.0, 0.0, 0.0, 0.1), Vec4::new(0.1, 0.0, 0.0, 0.3));
+        let ray = Ray::new(Vec3::new(-0.1, 0.0, 0.0), Vec3::Y);
+        assert_eq!(intersect(&first, 0, [None, Some((&next, 0))], &ray), None);
+        let hit = intersect(&next, 0, [Some((&first, 0)), None], &ray).unwrap();
+        assert!((f64::from(hit.t) - 0.05f64.sqrt()).abs() < 1e-5 && hit.u == 1.0, "{hit:?}");
     }
 }
