@@ -689,4 +689,18 @@ mod tests {
         let hit = intersect(&next, 0, [Some((&first, 0)), None], &ray).unwrap();
         assert!((f64::from(hit.t) - 0.05f64.sqrt()).abs() < 1e-5 && hit.u == 1.0, "{hit:?}");
     }
+
+    /// Inside a fat strand (two segments of radius 1.5 along x, -2 to 0 and 0 to 4), along x,
+    /// 0.5 off the axis from x = -0.5: the joint sphere's far side, x = √(1.5² - 0.5²) = √2,
+    /// and the far-end sphere's near side, x = 4 - √2, are both exactly 1 inside the second
+    /// cylinder; the ray leaves through the round end at x = 4 + √2, t = 4.5 + √2.
+    #[test]
+    fn inside_a_fat_strand_a_whole_unit_deep() {
+        let line = |a: f32, b: f32| [0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0].map(|s| Vec4::new(a + (b - a) * s, 0.0, 0.0, 1.5));
+        let (first, next) = (line(-2.0, 0.0), line(0.0, 4.0));
+        let ray = Ray::new(Vec3::new(-0.5, 0.5, 0.0), Vec3::X);
+        assert_eq!(intersect(&first, 0, [None, Some((&next, 0))], &ray), None);
+        let hit = intersect(&next, 0, [Some((&first, 0)), None], &ray).unwrap();
+        assert!((f64::from(hit.t) - (4.5 + 2f64.sqrt())).abs() < 1e-5 && hit.u == 1.0, "{hit:?}");
+    }
 }
