@@ -7,12 +7,13 @@
 //! traversal tests), relative to the root. Embree's greedy rule (open the child of largest
 //! area until `W` children) is one of the trees it considers, so the cost never rises.
 //! Subtrees of at most [`LEAF_PRIMS`] references may become leaves (two blocks); binary
-//! leaves always do.
+//! leaves always do. The plan also sizes what every subtree emits, so the output is
+//! allocated once and subtrees are emitted in parallel straight into their parts of it.
 
 use rayon::prelude::*;
 use raylab_core::{Aabb, Vec3};
 
-use super::node::{is_leaf, leaf_blocks, leaf_ref, ChildRef, TriBlock, WideNode, EMPTY, MAX_BLOCKS, MAX_LEAF_BLOCKS};
+use super::node::{leaf_ref, ChildRef, TriBlock, WideNode, EMPTY, MAX_BLOCKS, MAX_LEAF_BLOCKS};
 use crate::bvh::{Bvh, BvhNode};
 use crate::par::DisjointSlice;
 use crate::Primitives;
@@ -21,8 +22,8 @@ use crate::Primitives;
 pub const LEAF_PRIMS: usize = 8;
 
 /// Wide nodes over at least this many references emit their children's subtrees as
-/// parallel tasks, each into buffers of its own, appended in lane order afterwards: the
-/// serial emission's layout, whatever the thread count.
+/// parallel tasks, each into its own part of the output (sized by the plan): the serial
+/// emission's layout, whatever the thread count.
 const FORK_REFS: usize = 16 * 1024;
 
 /// The plan's bottom-up pass forks at binary nodes above this depth.
@@ -47,30 +48,85 @@ struct Ctx<'a, P: ?Sized, const W: usize> {
     fork_refs: usize,
 }
 
-/// Wide nodes and triangle blocks emitted by one task; its references count from 0.
-struct Out<const W: usize> {
-    nodes: Vec<WideNode<W>>,
-    blocks: Vec<TriBlock>,
+/// What a subtree emits: wide nodes and triangle blocks. The plan knows it before anything
+/// is emitted, so the output is allocated once and every subtree writes its own part of it.
+#[derive(Clone, Copy, Default, Debug, PartialEq)]
+struct Size {
+    nodes: usize,
+    blocks: usize,
+}
+
+impl std::ops::Add for Size {
+    type Output = Size;
+    fn add(self, o: Size) -> Size {
+        Size { nodes: self.nodes + o.nodes, blocks: self.blocks + o.blocks }
+    }
+}
+
+/// What a leaf of `refs` references emits (see [`Ctx::leaf`]): its blocks, or a wide node
+/// over chunks when they are too many for one reference.
+fn leaf_size<const W: usize>(refs: usize) -> Size {
+    let blocks = refs.div_ceil(4);
+    if blocks <= MAX_LEAF_BLOCKS {
+        return Size { nodes: 0, blocks };
+    }
+    let per = refs.div_ceil(W);
+    let (full, rest) = (refs / per, refs % per);
+    let mut size = Size { nodes: 1, blocks: 0 };
+    for _ in 0..full {
+        size = size + leaf_size::<W>(per);
+    }
+    if rest > 0 {
+        size = size + leaf_size::<W>(rest);
+    }
+    size
+}
+
+/// The part of the output one subtree writes: its nodes and blocks, and where they start in
+/// the whole output (references are absolute).
+struct Part<'o, const W: usize> {
+    nodes: &'o mut [WideNode<W>],
+    blocks: &'o mut [TriBlock],
+    node_base: usize,
+    block_base: usize,
+}
+
+impl<'o, const W: usize> Part<'o, W> {
+    /// Splits off the first `size` of this part for a subtree; `self` keeps the rest.
+    fn take(&mut self, size: Size) -> Part<'o, W> {
+        let (nodes, rest_n) = std::mem::take(&mut self.nodes).split_at_mut(size.nodes);
+        let (blocks, rest_b) = std::mem::take(&mut self.blocks).split_at_mut(size.blocks);
+        let head = Part { nodes, blocks, node_base: self.node_base, block_base: self.block_base };
+        (self.nodes, self.blocks) = (rest_n, rest_b);
+        self.node_base += size.nodes;
+        self.block_base += size.blocks;
+        head
+    }
 }
 
 pub(super) fn collapse<P: Primitives + ?Sized, const W: usize>(bvh: &Bvh, prims: &P) -> Collapsed<W> {
     collapse_forking(bvh, prims, FORK_REFS)
 }
 
-/// [`collapse`], forking the emission at wide nodes over `fork_refs` references or more
-/// (tests compare forking everywhere with never).
+/// [`collapse`], emitting the children of wide nodes over `fork_refs` references or more
+/// as parallel tasks (tests compare forking everywhere with never).
 fn collapse_forking<P: Primitives + ?Sized, const W: usize>(bvh: &Bvh, prims: &P, fork_refs: usize) -> Collapsed<W> {
     assert!(prims.len() < TriBlock::OTHER as usize, "wide BVH: more than 2^31 primitives");
     let bin = &bvh.nodes[..];
     if bin.is_empty() {
         return Collapsed { nodes: Vec::new(), blocks: Vec::new(), root: EMPTY, root_bounds: Aabb::EMPTY };
     }
-    let (plan, triangles) = rayon::join(|| plan::<W>(bin), || (0..prims.len() as u32).into_par_iter().map(|p| prims.triangle(p)).collect());
+    // Spatial splits may put one primitive in two leaves of a merged subtree, which then
+    // holds it once: the plan counts such leaves' distinct references.
+    let distinct = bvh.spatial_splits.then_some(&bvh.indices[..]);
+    let (plan, triangles) = rayon::join(|| plan::<W>(bin, distinct), || (0..prims.len() as u32).into_par_iter().map(|p| prims.triangle(p)).collect());
+    let size = plan[0].size;
+    assert!(size.blocks <= MAX_BLOCKS, "wide BVH: too many triangle blocks");
     let ctx = Ctx { bin, indices: &bvh.indices, prims, triangles, plan, fork_refs };
-    let mut out = Out { nodes: Vec::with_capacity(bin.len() / W + 1), blocks: Vec::with_capacity(prims.len() / 2 + 1) };
-    let root = ctx.child(0, &mut out);
-    assert!(out.blocks.len() <= MAX_BLOCKS, "wide BVH: too many triangle blocks");
-    Collapsed { nodes: out.nodes, blocks: out.blocks, root, root_bounds: bin[0].bounds() }
+    let mut nodes = vec![WideNode::EMPTY_NODE; size.nodes];
+    let mut blocks = vec![TriBlock::EMPTY_BLOCK; size.blocks];
+    let root = ctx.child(0, Part { nodes: &mut nodes, blocks: &mut blocks, node_base: 0, block_base: 0 });
+    Collapsed { nodes, blocks, root, root_bounds: bin[0].bounds() }
 }
 
 /// What the dynamic programme chose for one binary node.
@@ -90,35 +146,62 @@ struct Plan<const W: usize> {
     cost: f32,
     /// References below the node.
     refs: usize,
+    /// What the subtree emits, whole.
+    size: Size,
 }
 
 /// The dynamic programme, children before parents. `cost[j - 1]` is the least cost of a
 /// subtree spread over at most `j` slots of its parent; a wide node costs its area, a leaf
-/// its area times its blocks. Subtrees near the root are planned in parallel.
-fn plan<const W: usize>(bin: &[BvhNode]) -> Vec<Plan<W>> {
-    let mut plan = vec![Plan { leaf: true, split: [0; W], wide: 0, cost: 0.0, refs: 0 }; bin.len()];
+/// its area times its blocks. Subtrees near the root are planned in parallel. `distinct`:
+/// the leaves' references when they may repeat (spatial splits), to size leaves by the
+/// primitives they hold once.
+fn plan<const W: usize>(bin: &[BvhNode], distinct: Option<&[u32]>) -> Vec<Plan<W>> {
+    let mut plan = vec![Plan { leaf: true, split: [0; W], wide: 0, cost: 0.0, refs: 0, size: Size::default() }; bin.len()];
     if !bin.is_empty() {
-        plan_subtree(bin, 0, 0, &DisjointSlice::new(&mut plan));
+        plan_subtree(bin, distinct, 0, 0, &DisjointSlice::new(&mut plan));
     }
     plan
 }
 
-/// Plans binary node `i` at `depth` and its subtree; returns its references and `cost`.
-fn plan_subtree<const W: usize>(bin: &[BvhNode], i: usize, depth: usize, plan: &DisjointSlice<Plan<W>>) -> (usize, [f32; W]) {
+/// The distinct references of subtree `i` (see [`plan`]), or `refs` when they cannot repeat.
+fn distinct_refs(bin: &[BvhNode], distinct: Option<&[u32]>, i: usize, refs: usize) -> usize {
+    let Some(indices) = distinct else { return refs };
+    let mut all = Vec::with_capacity(refs);
+    gather(bin, indices, i, &mut all);
+    all.sort_unstable();
+    all.dedup();
+    all.len()
+}
+
+/// The references of subtree `i`, leaf by leaf.
+fn gather(bin: &[BvhNode], indices: &[u32], i: usize, out: &mut Vec<u32>) {
+    let n = &bin[i];
+    if n.is_leaf() {
+        out.extend_from_slice(&indices[n.left_first as usize..(n.left_first + n.count) as usize]);
+    } else {
+        gather(bin, indices, n.left_first as usize, out);
+        gather(bin, indices, n.left_first as usize + 1, out);
+    }
+}
+
+/// Plans binary node `i` at `depth` and its subtree; returns its references, `cost`, and
+/// `size[j - 1]`, what it emits over at most `j` slots (the sum over the nodes in them).
+fn plan_subtree<const W: usize>(bin: &[BvhNode], distinct: Option<&[u32]>, i: usize, depth: usize, plan: &DisjointSlice<Plan<W>>) -> (usize, [f32; W], [Size; W]) {
     let n = &bin[i];
     let area = n.bounds().half_area().max(0.0);
     if n.is_leaf() {
         let refs = n.count as usize;
         let as_leaf = area * refs.div_ceil(4) as f32;
+        let size = leaf_size::<W>(distinct_refs(bin, distinct, i, refs));
         // SAFETY: each node is planned once, by the one task that holds its subtree.
-        unsafe { plan.write(i, Plan { leaf: true, split: [0; W], wide: 0, cost: as_leaf, refs }) };
-        return (refs, [as_leaf; W]);
+        unsafe { plan.write(i, Plan { leaf: true, split: [0; W], wide: 0, cost: as_leaf, refs, size }) };
+        return (refs, [as_leaf; W], [size; W]);
     }
     let (l, r) = (n.left_first as usize, n.left_first as usize + 1);
-    let ((refs_l, cost_l), (refs_r, cost_r)) = if depth < FORK_DEPTH {
-        rayon::join(|| plan_subtree(bin, l, depth + 1, plan), || plan_subtree(bin, r, depth + 1, plan))
+    let ((refs_l, cost_l, size_l), (refs_r, cost_r, size_r)) = if depth < FORK_DEPTH {
+        rayon::join(|| plan_subtree(bin, distinct, l, depth + 1, plan), || plan_subtree(bin, distinct, r, depth + 1, plan))
     } else {
-        (plan_subtree(bin, l, depth + 1, plan), plan_subtree(bin, r, depth + 1, plan))
+        (plan_subtree(bin, distinct, l, depth + 1, plan), plan_subtree(bin, distinct, r, depth + 1, plan))
     };
     let refs = refs_l + refs_r;
     let as_leaf = area * refs.div_ceil(4) as f32;
@@ -135,53 +218,33 @@ fn plan_subtree<const W: usize>(bin: &[BvhNode], i: usize, depth: usize, plan: &
     let as_node = area + spread[W - 1].0;
     let leaf = refs <= LEAF_PRIMS && as_leaf <= as_node;
     let whole = if leaf { as_leaf } else { as_node };
-    let mut p = Plan { leaf, split: [0; W], wide: spread[W - 1].1, cost: whole, refs };
+    let wide = spread[W - 1].1 as usize;
+    let size = if leaf { leaf_size::<W>(distinct_refs(bin, distinct, i, refs)) } else { Size { nodes: 1, blocks: 0 } + size_l[wide - 1] + size_r[W - wide - 1] };
+    let mut p = Plan { leaf, split: [0; W], wide: wide as u8, cost: whole, refs, size };
     let mut cost = [whole; W];
+    let mut sizes = [size; W];
     for j in 2..=W {
         let (c, k) = spread[j - 1];
         if c < whole {
             cost[j - 1] = c;
             p.split[j - 1] = k;
+            sizes[j - 1] = size_l[k as usize - 1] + size_r[j - k as usize - 1];
         }
     }
     // SAFETY: as for the leaves above.
     unsafe { plan.write(i, p) };
-    (refs, cost)
-}
-
-impl<const W: usize> Out<W> {
-    fn new() -> Self {
-        Self { nodes: Vec::new(), blocks: Vec::new() }
-    }
-
-    /// Appends what another task emitted, its references moved past ours; returns its
-    /// root's reference here.
-    fn append(&mut self, root: ChildRef, part: Out<W>) -> ChildRef {
-        let (node_base, block_base) = (self.nodes.len() as u32, self.blocks.len());
-        let moved = |r: ChildRef| match r {
-            EMPTY => EMPTY,
-            r if is_leaf(r) => {
-                let (first, count) = leaf_blocks(r);
-                leaf_ref(first + block_base, count)
-            }
-            r => r + node_base,
-        };
-        self.nodes.extend(part.nodes.into_iter().map(|mut n| {
-            n.child = n.child.map(moved);
-            n
-        }));
-        self.blocks.extend_from_slice(&part.blocks);
-        moved(root)
-    }
+    (refs, cost, sizes)
 }
 
 impl<P: Primitives + ?Sized, const W: usize> Ctx<'_, P, W> {
-    /// The reference for binary node `i`, whole: a leaf or a wide node, as planned.
-    fn child(&self, i: usize, out: &mut Out<W>) -> ChildRef {
+    /// Emits binary node `i`, whole (a leaf or a wide node, as planned), into `out`, which
+    /// is exactly its planned size; returns its reference. The layout is depth first: a
+    /// wide node, then its lanes' subtrees in lane order, blocks in the same order.
+    fn child(&self, i: usize, mut out: Part<'_, W>) -> ChildRef {
         let n = &self.bin[i];
         if n.is_leaf() || self.plan[i].leaf {
             let mut refs = Vec::with_capacity(self.plan[i].refs);
-            self.gather(i, &mut refs);
+            gather(self.bin, self.indices, i, &mut refs);
             // Spatial splits may put one primitive in two leaves of a merged subtree.
             refs.sort_unstable();
             refs.dedup();
@@ -192,27 +255,18 @@ impl<P: Primitives + ?Sized, const W: usize> Ctx<'_, P, W> {
         let mut open = Vec::with_capacity(W);
         self.slots(l, k, &mut open);
         self.slots(l + 1, W - k, &mut open);
-        let slot = out.nodes.len();
-        out.nodes.push(WideNode::EMPTY_NODE);
-        if self.plan[i].refs >= self.fork_refs {
-            let parts: Vec<(ChildRef, Out<W>)> = open
-                .par_iter()
-                .map(|&c| {
-                    let mut part = Out::new();
-                    (self.child(c, &mut part), part)
-                })
-                .collect();
-            for (lane, (&c, (r, part))) in open.iter().zip(parts).enumerate() {
-                let r = out.append(r, part);
-                out.nodes[slot].set(lane, &self.bin[c].bounds(), r);
-            }
+        let node = out.take(Size { nodes: 1, blocks: 0 });
+        let lanes: Vec<(usize, Part<'_, W>)> = open.iter().map(|&c| (c, out.take(self.plan[c].size))).collect();
+        assert!(out.nodes.is_empty() && out.blocks.is_empty(), "the plan sized the subtree");
+        let refs: Vec<ChildRef> = if self.plan[i].refs >= self.fork_refs {
+            lanes.into_par_iter().map(|(c, part)| self.child(c, part)).collect()
         } else {
-            for (lane, &c) in open.iter().enumerate() {
-                let r = self.child(c, out);
-                out.nodes[slot].set(lane, &self.bin[c].bounds(), r);
-            }
+            lanes.into_iter().map(|(c, part)| self.child(c, part)).collect()
+        };
+        for (lane, (&c, r)) in open.iter().zip(refs).enumerate() {
+            node.nodes[0].set(lane, &self.bin[c].bounds(), r);
         }
-        slot as ChildRef
+        node.node_base as ChildRef
     }
 
     /// The binary nodes that subtree `i` puts in at most `j` slots of its parent.
@@ -227,44 +281,31 @@ impl<P: Primitives + ?Sized, const W: usize> Ctx<'_, P, W> {
         }
     }
 
-    fn gather(&self, i: usize, out: &mut Vec<u32>) {
-        let n = &self.bin[i];
-        if n.is_leaf() {
-            out.extend_from_slice(&self.indices[n.left_first as usize..(n.left_first + n.count) as usize]);
-        } else {
-            self.gather(n.left_first as usize, out);
-            self.gather(n.left_first as usize + 1, out);
-        }
-    }
-
-    /// A leaf over `refs` inside `bounds`; leaves too large for one reference (more than
-    /// [`MAX_LEAF_BLOCKS`] blocks, from builders that cannot split equal centroids) become
-    /// a wide node over chunks.
-    fn leaf(&self, refs: &[u32], bounds: Aabb, out: &mut Out<W>) -> ChildRef {
+    /// A leaf over `refs` inside `bounds`, into `out` (its [`leaf_size`]); leaves too large
+    /// for one reference (more than [`MAX_LEAF_BLOCKS`] blocks, from builders that cannot
+    /// split equal centroids) become a wide node over chunks.
+    fn leaf(&self, refs: &[u32], bounds: Aabb, mut out: Part<'_, W>) -> ChildRef {
         let blocks = refs.len().div_ceil(4);
         if blocks <= MAX_LEAF_BLOCKS {
-            let first = out.blocks.len();
-            for chunk in refs.chunks(4) {
-                let mut b = TriBlock::EMPTY_BLOCK;
+            assert!(out.nodes.is_empty() && out.blocks.len() == blocks, "the plan sized the leaf");
+            for (b, chunk) in out.blocks.iter_mut().zip(refs.chunks(4)) {
                 for (lane, &p) in chunk.iter().enumerate() {
                     match self.triangles[p as usize] {
                         Some(v) => b.set_triangle(lane, p, v),
                         None => b.prim[lane] = p | TriBlock::OTHER,
                     }
                 }
-                out.blocks.push(b);
             }
-            return leaf_ref(first, blocks);
+            return leaf_ref(out.block_base, blocks);
         }
         let per = refs.len().div_ceil(W);
-        let slot = out.nodes.len();
-        out.nodes.push(WideNode::EMPTY_NODE);
+        let node = out.take(Size { nodes: 1, blocks: 0 });
         for (lane, chunk) in refs.chunks(per).enumerate() {
             let cb = chunk.iter().fold(Aabb::EMPTY, |b, &p| b.union(self.prims.bounds(p))).intersection(bounds);
-            let r = self.leaf(chunk, cb, out);
-            out.nodes[slot].set(lane, &cb, r);
+            let r = self.leaf(chunk, cb, out.take(leaf_size::<W>(chunk.len())));
+            node.nodes[0].set(lane, &cb, r);
         }
-        slot as ChildRef
+        node.node_base as ChildRef
     }
 }
 
@@ -302,18 +343,50 @@ mod tests {
         }
     }
 
+    /// A leaf's size by hand: 64 references fill 16 blocks, one reference; 65 are chunked 9
+    /// per lane (seven chunks of 9, three blocks each, and one of 2) under one wide node;
+    /// 200 over 4 lanes are four chunks of 50, 13 blocks each.
+    #[test]
+    fn leaf_sizes_by_hand() {
+        assert_eq!(leaf_size::<8>(64), Size { nodes: 0, blocks: 16 });
+        assert_eq!(leaf_size::<8>(65), Size { nodes: 1, blocks: 7 * 3 + 1 });
+        assert_eq!(leaf_size::<4>(200), Size { nodes: 1, blocks: 4 * 13 });
+        assert_eq!(leaf_size::<4>(0), Size { nodes: 0, blocks: 0 });
+    }
+
+    /// The plan's sizes are what is emitted, with leaves too large for one reference (300
+    /// equal boxes: no plane separates their centroids, the builder makes leaves of 8 and
+    /// the collapse merges none) and with repeated references (the same primitives in two
+    /// leaves, as spatial splits make them).
+    #[test]
+    fn the_plan_sizes_what_is_emitted() {
+        let same = crate::primitives::TestBoxes(vec![Aabb::new(Vec3::ZERO, Vec3::ONE); 300]);
+        let bin = vec![BvhNode::leaf(aabb(1.0, 1.0, 1.0), 0, 300)];
+        let bvh = Bvh::from_parts(bin, (0..300).collect(), 300, "one big leaf");
+        let c = collapse_forking::<_, 8>(&bvh, &same, 1);
+        // Chunks of 38: seven of ten blocks and one of 34 references, nine blocks.
+        assert_eq!(leaf_size::<8>(300), Size { nodes: 1, blocks: 7 * 10 + 9 });
+        assert_eq!((c.nodes.len(), c.blocks.len()), (1, 79));
+        // Leaves {0..4} and {2..6}, both whole in one leaf of six distinct primitives.
+        let bin = vec![BvhNode::interior(aabb(1.0, 1.0, 1.0), 1), BvhNode::leaf(aabb(1.0, 1.0, 1.0), 0, 4), BvhNode::leaf(aabb(1.0, 1.0, 1.0), 4, 4)];
+        let bvh = Bvh::from_parts(bin, vec![0, 1, 2, 3, 2, 3, 4, 5], 6, "repeats").with_spatial_splits();
+        let c = collapse_forking::<_, 8>(&bvh, &crate::primitives::TestBoxes(vec![Aabb::new(Vec3::ZERO, Vec3::ONE); 6]), 1);
+        assert_eq!((c.root, c.nodes.len(), c.blocks.len()), (leaf_ref(0, 2), 0, 2));
+        assert_eq!(c.blocks[1].prim.map(|p| p & !TriBlock::OTHER), [4, 5, EMPTY & !TriBlock::OTHER, EMPTY & !TriBlock::OTHER]);
+    }
+
     /// Two leaves of three filling their parent's box: as one leaf of two blocks the parent
     /// costs 3 · 2 = 6 (half area 3 of the unit cube, two blocks); as a wide node over two
     /// one-block leaves 3 + 3 + 3 = 9. The greedy rule (leaves of at most four) took the node.
     #[test]
     fn six_triangles_in_one_box_make_one_leaf() {
         let bin = [BvhNode::interior(aabb(1.0, 1.0, 1.0), 1), BvhNode::leaf(aabb(1.0, 1.0, 1.0), 0, 3), BvhNode::leaf(aabb(1.0, 1.0, 1.0), 3, 3)];
-        let whole = plan::<8>(&bin);
+        let whole = plan::<8>(&bin, None);
         assert!(whole[0].leaf);
         assert_eq!(whole[0].cost, 6.0);
         // Small children, half area 0.25 each (0.5 × 0.5 × 0): as a node 3 + 0.25 + 0.25 = 3.5 < 6.
         let bin = [BvhNode::interior(aabb(1.0, 1.0, 1.0), 1), BvhNode::leaf(aabb(0.5, 0.5, 0.0), 0, 3), BvhNode::leaf(aabb(0.5, 0.5, 0.0), 3, 3)];
-        assert!(!plan::<8>(&bin)[0].leaf);
+        assert!(!plan::<8>(&bin, None)[0].leaf);
     }
 
     /// Root R (half area 3) over A (interior, half area 2, over two leaves of eight, half area
@@ -333,7 +406,7 @@ mod tests {
         for (i, want) in [3.0, 2.0, 1.0, 1.0, 1.0].into_iter().enumerate() {
             assert_eq!(bin[i].bounds().half_area(), want, "node {i}");
         }
-        let plan = plan::<4>(&bin);
+        let plan = plan::<4>(&bin, None);
         assert_eq!((plan[0].cost, plan[1].cost, plan[2].cost), (8.0, 6.0, 1.0));
         assert!(!plan[0].leaf && !plan[1].leaf, "20 and 16 references are too many for a leaf");
         assert_eq!(plan[0].wide, 2, "A takes two of R's four slots");
@@ -400,7 +473,7 @@ mod tests {
             BvhNode::leaf(leaf, 28, 8),
         ];
         assert_eq!(c.half_area(), 1.5);
-        let plan = plan::<4>(&bin);
+        let plan = plan::<4>(&bin, None);
         assert_eq!(plan.iter().map(|p| p.cost).collect::<Vec<_>>(), [13.5, 1.0, 10.0, 5.5, 5.5, 2.0, 2.0, 2.0, 2.0]);
         assert_eq!(plan[0].wide, 1, "A takes one of R's slots, B three");
         assert_eq!(plan[2].split[2], 1, "B over three slots: C1 whole, C2 over two");
