@@ -1,5 +1,8 @@
 //! Top-down builders. Subtrees are built in parallel (`rayon::join`) into a temporary
-//! tree, which is then flattened depth-first with siblings adjacent, in parallel too.
+//! tree, which is then flattened depth-first with siblings adjacent, in parallel too. Below
+//! [`PARALLEL_THRESHOLD`] primitives a subtree is built on one thread straight into flat
+//! nodes in that layout (siblings allocated side by side, as tinybvh does), which the
+//! flattening only moves: no boxed node and no second walk for most of the tree.
 //!
 //! Primitives travel as [`PrimRef`]s, box and index together (Embree's layout), which the
 //! splits partition (stably, in parallel at the top of the tree): binning and partitioning stream through memory instead of
@@ -24,10 +27,15 @@ const BIN_CHUNK: usize = 1 << 13;
 /// Threads from which large nodes partition in parallel (see [`partition`]).
 const PARALLEL_PARTITION_THREADS: usize = 4;
 
+/// The tree above [`PARALLEL_THRESHOLD`], built by parallel tasks, whose subtrees below it
+/// arrive already flat.
 enum BuildNode {
     Leaf { bounds: Aabb, first: u32, count: u32 },
     /// `descendants`: the flat nodes below it, which [`flatten`] lays out.
     Interior { bounds: Aabb, children: Box<[BuildNode; 2]>, descendants: usize },
+    /// A subtree built on one thread straight into flat nodes in [`flatten`]'s layout:
+    /// its root first, node references counted from it.
+    Flat(Vec<BvhNode>),
 }
 
 impl BuildNode {
@@ -35,6 +43,7 @@ impl BuildNode {
         match self {
             BuildNode::Leaf { .. } => 0,
             BuildNode::Interior { descendants, .. } => *descendants,
+            BuildNode::Flat(nodes) => nodes.len() - 1,
         }
     }
 }
@@ -172,6 +181,14 @@ pub(super) fn build<P: Primitives + ?Sized>(prims: &P, method: SplitMethod, opts
 fn flatten(node: BuildNode, base: usize, below: &mut [BvhNode]) -> BvhNode {
     match node {
         BuildNode::Leaf { bounds, first, count } => BvhNode::leaf(bounds, first, count),
+        BuildNode::Flat(nodes) => {
+            // Node k ≥ 1 of the subtree lands at `base + k - 1`.
+            let moved = |n: &BvhNode| if n.is_leaf() { *n } else { BvhNode { left_first: n.left_first + base as u32 - 1, ..*n } };
+            for (to, n) in below.iter_mut().zip(&nodes[1..]) {
+                *to = moved(n);
+            }
+            moved(&nodes[0])
+        }
         BuildNode::Interior { bounds, children, descendants } => {
             let [l, r] = *children;
             let (pair, rest) = below.split_at_mut(2);
@@ -207,6 +224,12 @@ impl Ctx {
     /// Builds the subtree over `refs` (bounded by `extent`), whose first element sits at
     /// `offset` in the final primitive order.
     fn build(&self, refs: &mut [PrimRef], extent: Extent, offset: usize, depth: usize, scratch: &mut Scratch) -> BuildNode {
+        if refs.len() < PARALLEL_THRESHOLD {
+            let mut nodes = Vec::with_capacity(refs.len());
+            nodes.push(BvhNode::interior(Aabb::EMPTY, 0));
+            self.build_flat(refs, extent, offset, depth, scratch, &mut nodes, 0);
+            return BuildNode::Flat(nodes);
+        }
         let bounds = extent.geom.aabb();
         let leaf = BuildNode::Leaf { bounds, first: offset as u32, count: refs.len() as u32 };
         if refs.len() <= 1 || depth >= MAX_DEPTH {
@@ -214,13 +237,28 @@ impl Ctx {
         }
         let Some((mid, le, re)) = self.split(refs, &extent, scratch) else { return leaf };
         let (l, r) = refs.split_at_mut(mid);
-        let (left, right) = if l.len() + r.len() >= PARALLEL_THRESHOLD {
-            rayon::join(|| self.build(l, le, offset, depth + 1, scratch), || self.build(r, re, offset + mid, depth + 1, &mut Scratch::new(self.bins)))
-        } else {
-            (self.build(l, le, offset, depth + 1, scratch), self.build(r, re, offset + mid, depth + 1, scratch))
-        };
+        let (left, right) = rayon::join(|| self.build(l, le, offset, depth + 1, scratch), || self.build(r, re, offset + mid, depth + 1, &mut Scratch::new(self.bins)));
         let descendants = 2 + left.descendants() + right.descendants();
         BuildNode::Interior { bounds, children: Box::new([left, right]), descendants }
+    }
+
+    /// [`Ctx::build`] on this thread, writing node `at` of `nodes` and appending its
+    /// subtree as [`flatten`] lays it out: the two children side by side, then the left
+    /// child's subtree, then the right's (tinybvh's order of allocation).
+    #[allow(clippy::too_many_arguments)]
+    fn build_flat(&self, refs: &mut [PrimRef], extent: Extent, offset: usize, depth: usize, scratch: &mut Scratch, nodes: &mut Vec<BvhNode>, at: usize) {
+        let bounds = extent.geom.aabb();
+        let split = if refs.len() <= 1 || depth >= MAX_DEPTH { None } else { self.split(refs, &extent, scratch) };
+        let Some((mid, le, re)) = split else {
+            nodes[at] = BvhNode::leaf(bounds, offset as u32, refs.len() as u32);
+            return;
+        };
+        let pair = nodes.len();
+        nodes.extend([BvhNode::interior(Aabb::EMPTY, 0); 2]);
+        nodes[at] = BvhNode::interior(bounds, pair as u32);
+        let (l, r) = refs.split_at_mut(mid);
+        self.build_flat(l, le, offset, depth + 1, scratch, nodes, pair);
+        self.build_flat(r, re, offset + mid, depth + 1, scratch, nodes, pair + 1);
     }
 
     /// Partitions `refs`, or `None` for a leaf.
