@@ -294,27 +294,6 @@ fn binned_sah_leaf_or_split_decision_follows_the_cost_formula() {
 }
 
 #[test]
-fn binned_sah_counts_in_blocks_for_the_wide_layouts() {
-    // Two rows of k unit cubes, at x = 0, 1, ... and x = 20, 21, ... With `leaf_block` 4 a
-    // side costs its blocks ⌈n/4⌉. k = 2: the root (22 × 1 × 1, half area 45) splits into
-    // its rows (half area 5 each) for 1 + (5 + 5)/45 = 1.22 against a leaf of one block, 1:
-    // a leaf. Counting primitives, 1 + (5·2 + 5·2)/45 = 1.44 < 4 splits, and each row stays
-    // a leaf (1 + (3 + 3)/5 = 2.2 ≥ 2). k = 4 (half area 49, rows 9): 1 + (9 + 9)/49 = 1.37
-    // < 2 blocks: split, and each row of four, one block, is a leaf (any split costs > 1).
-    let group = |k: usize| Boxes((0..k).map(|i| cube_at(i as f32 + 0.5, 0.5)).chain((0..k).map(|i| cube_at(20.0 + i as f32 + 0.5, 0.5))).collect());
-    let blocks = BuildOptions { leaf_block: 4, ..opts(1.0, 1.0, 8, 16) };
-    let s = group(2);
-    assert_eq!(shape(&Bvh::build(&s, SplitMethod::BinnedSah, &blocks)), "[0 1 2 3]");
-    assert_eq!(shape(&Bvh::build(&s, SplitMethod::BinnedSah, &opts(1.0, 1.0, 8, 16))), "([0 1] [2 3])");
-    let s = group(4);
-    let b = Bvh::build(&s, SplitMethod::BinnedSah, &blocks);
-    b.validate(&s).unwrap();
-    assert_eq!(shape(&b), "([0 1 2 3] [4 5 6 7])");
-    // A leaf larger than `max_leaf_size` still splits, whatever the blocks say.
-    assert_eq!(shape(&Bvh::build(&group(2), SplitMethod::BinnedSah, &BuildOptions { leaf_block: 4, ..opts(1.0, 1.0, 2, 16) })), "([0 1] [2 3])");
-}
-
-#[test]
 fn binned_sah_bins_by_centroid_position() {
     // Eight unit cubes at x = 0, 1, 2, 3, 10, 11, 12, 13 with 2 bins: centroids 0.5 .. 13.5,
     // bin width 6.5: the first four in bin 0. Cost 1 + (4·(4 + 1 + 4)·2)/(14 + 1 + 14) =

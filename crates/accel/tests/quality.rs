@@ -46,20 +46,15 @@ const RECORDED: &[(&str, &str, f64, f64, f64)] = &[
     ("clusters", "sbvh", 21.42, 15.0, 0.44),
     // The wide layouts, recorded 2026-11-25 after the cost-driven collapse (the greedy one
     // gave SAH 9.49 and 7.85 for `bvh8`): SAH cost in node visits plus block tests, tests per
-    // ray counting every occupied lane of a block tested. `bvh8`, `bvh4` and `bvh8q`
-    // re-recorded 2026-11-26 when their binary trees began counting in blocks of four
-    // (`BuildOptions::leaf_block`, Embree's rule): the SAH cost in blocks held (bunny 8.86
-    // → 8.91, clusters 7.25 → 7.93) and leaves fill their blocks, so more lanes are tested
-    // per ray (2.64 → 3.36, 2.90 → 6.88), four at a time; a 200k-triangle soup like
-    // `clusters` traces 1.07-1.15x faster (docs/performance.md, "Eighth round").
-    ("bunny", "bvh8", 8.91, 6.0, 3.36),
-    ("bunny", "bvh4", 12.25, 9.0, 3.55),
+    // ray counting every occupied lane of a block tested.
+    ("bunny", "bvh8", 8.86, 6.0, 2.64),
+    ("bunny", "bvh4", 12.19, 8.0, 3.03),
     ("bunny", "bvh8-sbvh", 8.84, 6.0, 2.62),
-    ("bunny", "bvh8q", 9.05, 6.0, 3.46),
-    ("clusters", "bvh8", 7.93, 6.0, 6.88),
-    ("clusters", "bvh4", 11.23, 7.0, 6.98),
+    ("bunny", "bvh8q", 9.01, 6.0, 2.71),
+    ("clusters", "bvh8", 7.25, 6.0, 2.90),
+    ("clusters", "bvh4", 10.62, 7.0, 3.54),
     ("clusters", "bvh8-sbvh", 7.23, 6.0, 2.87),
-    ("clusters", "bvh8q", 8.08, 6.0, 7.08),
+    ("clusters", "bvh8q", 7.42, 6.0, 3.02),
 ];
 
 /// The scenes, all in the repository (never `../shared`): the 4968-triangle bunny, and a
