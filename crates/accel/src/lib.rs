@@ -201,11 +201,17 @@ pub struct BuildOptions {
     pub spatial_split_alpha: f32,
     /// Builder of the binary tree under `bvh`, `bvh4` and `bvh8`.
     pub quality: BuildQuality,
+    /// The binned SAH counts a side's primitives in blocks of this many (Embree's
+    /// `logBlockSize`): a leaf costs one test per block, plus a share per triangle that
+    /// keeps a large triangle out of a block of small ones. 1 for binary BVHs; the wide
+    /// layouts build with 4, the triangles their leaves test at once, which ends the
+    /// binary tree at the leaves they will hold.
+    pub leaf_block: usize,
 }
 
 impl Default for BuildOptions {
     fn default() -> Self {
-        Self { traversal_cost: 1.0, intersection_cost: 1.0, max_leaf_size: 8, bins: 16, grid_density: 4.0, grid_max_resolution: 128, ploc_radius: 16, empty_bonus: 0.2, spatial_split_alpha: 1e-5, quality: BuildQuality::Medium }
+        Self { traversal_cost: 1.0, intersection_cost: 1.0, max_leaf_size: 8, bins: 16, grid_density: 4.0, grid_max_resolution: 128, ploc_radius: 16, empty_bonus: 0.2, spatial_split_alpha: 1e-5, quality: BuildQuality::Medium, leaf_block: 1 }
     }
 }
 
@@ -244,6 +250,26 @@ pub(crate) fn leaf_margin(scene: &Aabb) -> f32 {
 
 /// The binary BVH of `opts.quality`, named `name` (the user's choice, whatever the builder).
 fn binary_at_quality<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions, name: &'static str) -> Bvh {
+    build_binary(prims, opts, name)
+}
+
+/// The binary BVH a wide layout is converted from: [`binary_at_quality`], with the binned
+/// SAH counting in the leaves' blocks of four ([`BuildOptions::leaf_block`]) when every
+/// primitive is a triangle. Other primitives are tested one call each, whatever block
+/// they share, so there a leaf's cost stays one per primitive.
+pub fn binary_for_wide<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions, name: &'static str) -> Bvh {
+    if !all_triangles(prims) {
+        return build_binary(prims, opts, name);
+    }
+    build_binary(prims, &BuildOptions { leaf_block: 4, max_leaf_size: opts.max_leaf_size.min(4), ..opts.clone() }, name)
+}
+
+fn all_triangles<P: Primitives + ?Sized>(prims: &P) -> bool {
+    use rayon::prelude::*;
+    (0..prims.len() as u32).into_par_iter().with_min_len(4096).all(|i| prims.is_triangle(i))
+}
+
+fn build_binary<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions, name: &'static str) -> Bvh {
     let mut bvh = match opts.quality {
         BuildQuality::Low => bvh::lbvh::build(prims, opts),
         BuildQuality::Medium => Bvh::build(prims, SplitMethod::BinnedSah, opts),
@@ -299,10 +325,10 @@ impl AnyAccel {
             AccelKind::KdTree => AnyAccel::KdTree(KdTree::build(prims, opts)),
             AccelKind::SphereBvh => AnyAccel::SphereBvh(SphereBvh::build(prims, opts)),
             AccelKind::Sbvh => AnyAccel::Bvh(bvh::sbvh::build(prims, opts)),
-            AccelKind::Bvh8 => AnyAccel::Bvh8(WideBvh::from_binary(&binary_at_quality(prims, opts, "bvh"), prims, "bvh8")),
-            AccelKind::Bvh4 => AnyAccel::Bvh4(WideBvh::from_binary(&binary_at_quality(prims, opts, "bvh"), prims, "bvh4")),
+            AccelKind::Bvh8 => AnyAccel::Bvh8(WideBvh::from_binary(&binary_for_wide(prims, opts, "bvh"), prims, "bvh8")),
+            AccelKind::Bvh4 => AnyAccel::Bvh4(WideBvh::from_binary(&binary_for_wide(prims, opts, "bvh"), prims, "bvh4")),
             AccelKind::Bvh8Sbvh => AnyAccel::Bvh8(WideBvh::from_binary(&bvh::sbvh::build(prims, opts), prims, "bvh8-sbvh")),
-            AccelKind::Bvh8Q => AnyAccel::Bvh8Q(WideBvh::from_binary(&binary_at_quality(prims, opts, "bvh"), prims, "bvh8q")),
+            AccelKind::Bvh8Q => AnyAccel::Bvh8Q(WideBvh::from_binary(&binary_for_wide(prims, opts, "bvh"), prims, "bvh8q")),
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
         dispatch!(&mut accel, a => a.build_ms = ms);

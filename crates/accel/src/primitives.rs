@@ -54,6 +54,12 @@ pub trait Primitives: Sync {
         None
     }
 
+    /// Whether [`Primitives::triangle`] is `Some` for primitive `i`, without loading the
+    /// vertices where the implementation can tell.
+    fn is_triangle(&self, i: u32) -> bool {
+        self.triangle(i).is_some()
+    }
+
     /// Bounds of the part of primitive `i` that lies inside `clip`, for spatial splits
     /// (kd-tree "perfect splits", SBVH, grid cells). The default, `bounds ∩ clip`, is
     /// conservative; triangles should clip exactly (`raylab_core::clip::triangle_bounds`, as

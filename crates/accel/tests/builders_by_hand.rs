@@ -9,7 +9,7 @@
 use raylab_accel::bvh::{self, lbvh, morton, Bvh, BvhNode, SplitMethod};
 use raylab_accel::{Accel, BuildOptions, Counters};
 use raylab_core::{Aabb, Ray, Vec3};
-use raylab_testkit::{bvh_shape as shape, Boxes};
+use raylab_testkit::{bvh_shape as shape, Boxes, Prim, Soup};
 
 fn aabb(min: [f32; 3], max: [f32; 3]) -> Aabb {
     Aabb::new(Vec3::from_array(min), Vec3::from_array(max))
@@ -291,6 +291,59 @@ fn binned_sah_leaf_or_split_decision_follows_the_cost_formula() {
         b.validate(&s).unwrap();
         assert_eq!(shape(&b), if split { "(0 1)" } else { "[0 1]" }, "gap {g}, T {t}, I {i}, max leaf {max_leaf}");
     }
+}
+
+#[test]
+fn binned_sah_counts_in_blocks_for_the_wide_layouts() {
+    // With `leaf_block` 4 a side of n costs c(n) = ⌈n/4⌉ + 0.35·n (one test per block and a
+    // share per triangle): c(1) = 1.35, c(2) = 1.7, c(3) = 2.05, c(4) = 2.4, c(8) = 4.8.
+    // Two rows of four unit cubes, at x = 0..4 and x = 20..24: the root (24 × 1 × 1, half
+    // area 49) splits into its rows (half area 9 each) for 1 + 2·9·2.4/49 = 1.88 < 4.8. A row
+    // stays one leaf, 2.4, against 1 + 2·5·1.7/9 = 2.89 for halves of two (half area 5) and
+    // 1 + (3·1.35 + 7·2.05)/9 = 3.04 for one and three. Counting primitives the rows split
+    // (1 + 2·5·2/9 = 3.22 < 4) into pairs that stay leaves (1 + (3 + 3)/5 = 2.2 ≥ 2).
+    let rows = Boxes((0..4).map(|i| cube_at(i as f32 + 0.5, 0.5)).chain((0..4).map(|i| cube_at(20.0 + i as f32 + 0.5, 0.5))).collect());
+    let blocks = BuildOptions { leaf_block: 4, ..opts(1.0, 1.0, 8, 16) };
+    let b = Bvh::build(&rows, SplitMethod::BinnedSah, &blocks);
+    b.validate(&rows).unwrap();
+    assert_eq!(shape(&b), "([0 1 2 3] [4 5 6 7])");
+    assert_eq!(shape(&Bvh::build(&rows, SplitMethod::BinnedSah, &opts(1.0, 1.0, 8, 16))), "(([0 1] [2 3]) ([4 5] [6 7]))");
+    // A leaf larger than `max_leaf_size` still splits, whatever the blocks say.
+    assert_eq!(shape(&Bvh::build(&rows, SplitMethod::BinnedSah, &BuildOptions { leaf_block: 4, ..opts(1.0, 1.0, 2, 16) })), "(([0 1] [2 3]) ([4 5] [6 7]))");
+}
+
+#[test]
+fn binned_sah_in_blocks_splits_a_large_primitive_from_small_ones() {
+    // A cube of side 10 at the origin (half area 300) and three cubes of side 0.1 at x = 4,
+    // 4.2, 4.4 inside it (together 0.5 × 0.1 × 0.1, half area 0.11). Splitting the large one
+    // off costs 1 + (300·c(1) + 0.11·c(3))/300 = 2.351 against a leaf of all four, c(4) =
+    // 2.4: a split. Counting blocks alone (c(n) = ⌈n/4⌉) it would be 2.0004 against 1, a
+    // leaf whose one block every ray reaching the large cube would test; the per-triangle
+    // share must exceed a third for the split to win (c(4) - c(1) > the traversal cost).
+    // The three small ones stay a leaf: 2.05 against 1 + (0.03·1.35 + 0.07·1.7)/0.11 = 2.45.
+    let s = Boxes(vec![cube_at(0.0, 5.0), cube_at(4.0, 0.05), cube_at(4.2, 0.05), cube_at(4.4, 0.05)]);
+    let b = Bvh::build(&s, SplitMethod::BinnedSah, &BuildOptions { leaf_block: 4, ..opts(1.0, 1.0, 8, 16) });
+    b.validate(&s).unwrap();
+    assert_eq!(shape(&b), "(0 [1 2 3])");
+}
+
+#[test]
+fn wide_layouts_count_in_blocks_only_when_every_primitive_is_a_triangle() {
+    // The rows of `binned_sah_counts_in_blocks_for_the_wide_layouts` as triangles, each
+    // spanning its unit cube: in blocks, one leaf per row. With the last one a sphere of
+    // the same bounds, which a leaf tests with a call of its own whatever block it shares,
+    // the binary tree under the wide layouts counts primitives: pairs.
+    let tri = |x: f32| Prim::Triangle([Vec3::new(x, -0.5, -0.5), Vec3::new(x + 1.0, 0.5, -0.5), Vec3::new(x + 1.0, 0.5, 0.5)]);
+    let xs = [0.0, 1.0, 2.0, 3.0, 20.0, 21.0, 22.0, 23.0];
+    let triangles = Soup::new(xs.iter().map(|&x| tri(x)).collect());
+    let opts = BuildOptions::default();
+    assert_eq!(shape(&raylab_accel::binary_for_wide(&triangles, &opts, "bvh")), "([0 1 2 3] [4 5 6 7])");
+    let mut mixed: Vec<Prim> = xs[..7].iter().map(|&x| tri(x)).collect();
+    mixed.push(Prim::Sphere { center: Vec3::new(23.5, 0.0, 0.0), radius: 0.5 });
+    let mixed = Soup::new(mixed);
+    let b = raylab_accel::binary_for_wide(&mixed, &opts, "bvh");
+    b.validate(&mixed).unwrap();
+    assert_eq!(shape(&b), "(([0 1] [2 3]) ([4 5] [6 7]))");
 }
 
 #[test]

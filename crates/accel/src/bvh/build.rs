@@ -133,11 +133,34 @@ impl Extent {
     }
 }
 
+/// The part of a leaf's cost that grows with its triangles when the SAH counts in blocks.
+/// Counting blocks alone, a leaf of one large triangle and three small ones costs what the
+/// large one alone costs, so it is never split; rays that reach the large triangle then
+/// test the small ones' block too, and renders of scenes with large walls or floors next
+/// to small triangles got 1.1-1.25x slower (docs/performance.md, "Ninth round"). Splitting
+/// off the large triangle costs one traversal step and saves `c(4) - c(1)`, three times
+/// this share: just above a third, splitting wins.
+const PER_TRIANGLE: f32 = 0.35;
+
 struct Ctx {
     method: SplitMethod,
     sah: SahCost,
     max_leaf: usize,
     bins: usize,
+    /// [`BuildOptions::leaf_block`].
+    block: usize,
+}
+
+impl Ctx {
+    /// The tests a side of `n` primitives costs: `n`, or in blocks, one per block plus
+    /// [`PER_TRIANGLE`] per triangle.
+    #[inline]
+    fn blocks(&self, n: usize) -> f32 {
+        if self.block == 1 {
+            return n as f32;
+        }
+        n.div_ceil(self.block) as f32 + PER_TRIANGLE * n as f32
+    }
 }
 
 /// A split: the size of the left part (now in front) and the extents of both parts.
@@ -155,7 +178,7 @@ pub(super) fn build<P: Primitives + ?Sized>(prims: &P, method: SplitMethod, opts
             PrimRef { min: b.min.into(), max: b.max.into(), id: i }
         })
         .collect();
-    let ctx = Ctx { method, sah: SahCost::from_options(opts), max_leaf: opts.max_leaf_size.max(1), bins: opts.bins.clamp(2, 256) };
+    let ctx = Ctx { method, sah: SahCost::from_options(opts), max_leaf: opts.max_leaf_size.max(1), bins: opts.bins.clamp(2, 256), block: opts.leaf_block.max(1) };
     let extent = Extent::of(&refs);
     let root = ctx.build(&mut refs, extent, 0, 1, &mut Scratch::new(ctx.bins));
     let mut nodes: Vec<BvhNode> = (0..1 + root.descendants()).into_par_iter().map(|_| BvhNode::interior(Aabb::EMPTY, 0)).collect();
@@ -319,9 +342,9 @@ impl Ctx {
                     continue;
                 }
                 let cost = if pa > 0.0 {
-                    self.sah.traversal + self.sah.intersection * (acc.half_area() * cnt as f32 + right_area[p] * right_count[p] as f32) / pa
+                    self.sah.traversal + self.sah.intersection * (acc.half_area() * self.blocks(cnt) + right_area[p] * self.blocks(right_count[p])) / pa
                 } else {
-                    self.sah.traversal + self.sah.intersection * refs.len() as f32
+                    self.sah.traversal + self.sah.intersection * (self.blocks(cnt) + self.blocks(right_count[p]))
                 };
                 if best_axis == 3 || cost < best_cost {
                     (best_cost, best_axis, best_plane) = (cost, axis, p);
@@ -329,7 +352,7 @@ impl Ctx {
             }
         }
         let (axis, plane) = (best_axis, best_plane);
-        if axis == 3 || (best_cost >= self.sah.leaf(refs.len()) && refs.len() <= self.max_leaf) {
+        if axis == 3 || (best_cost >= self.sah.intersection * self.blocks(refs.len()) && refs.len() <= self.max_leaf) {
             return None;
         }
         // Bin `⌊clamp((c - lo) · s, 0, nb - 1)⌋ < plane` as one comparison: the plane is a

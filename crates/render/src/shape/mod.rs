@@ -236,6 +236,10 @@ impl Primitives for Geometry {
         }
     }
 
+    fn is_triangle(&self, i: u32) -> bool {
+        matches!(self.prims[i as usize], PrimRef::Triangle { .. })
+    }
+
     fn objects(&self) -> Vec<Range<u32>> {
         self.objects.clone()
     }
