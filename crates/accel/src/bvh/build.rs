@@ -9,7 +9,7 @@
 //! following an index into separate box and centroid arrays, and a partition hands each
 //! side its box and its centroids' box, so no node reads its primitives again to bound them.
 
-use glam::Vec3A;
+use glam::{Vec3A, Vec4};
 use rayon::prelude::*;
 use raylab_core::Aabb;
 
@@ -48,19 +48,47 @@ impl BuildNode {
     }
 }
 
-/// A primitive's box and its index in the input.
+/// A primitive's box and its index in the input, in 32 bytes (Embree's layout): the index
+/// rides in the fourth lane of the minimum, which the box arithmetic carries along and
+/// ignores. Binning and partitioning stream these through memory at every level of the
+/// tree; at 48 bytes (a separate index and padding) they moved half as much again.
+///
+/// The fourth lanes always hold normal floats, so that the centroid's arithmetic, which
+/// runs on all four lanes, never meets a denormal (microcode assists on many CPUs): the
+/// index is stored as the bits `id + 2²³` (exponent at least 1; finite below
+/// [`MAX_PRIMS`]) and the maximum's fourth lane is 1.
 #[derive(Clone, Copy)]
 struct PrimRef {
-    min: Vec3A,
+    min_id: Vec4,
     max: Vec3A,
-    id: u32,
 }
 
+const _: () = assert!(std::mem::size_of::<PrimRef>() == 32);
+
+/// Primitives a binary BVH can index ([`PrimRef`]'s encoding).
+const MAX_PRIMS: usize = 1 << 30;
+const ID_BIAS: u32 = 1 << 23;
+
 impl PrimRef {
+    #[inline]
+    fn new(min: Vec3A, max: Vec3A, id: u32) -> Self {
+        Self { min_id: min.extend(f32::from_bits(id + ID_BIAS)), max: Vec3A::from_vec4(max.extend(1.0)) }
+    }
+
+    #[inline]
+    fn min(&self) -> Vec3A {
+        Vec3A::from_vec4(self.min_id)
+    }
+
+    #[inline]
+    fn id(&self) -> u32 {
+        self.min_id.w.to_bits() - ID_BIAS
+    }
+
     /// The same arithmetic as [`Aabb::centroid`], lane by lane.
     #[inline]
     fn centroid(&self) -> Vec3A {
-        0.5 * (self.min + self.max)
+        0.5 * (self.min() + self.max)
     }
 }
 
@@ -109,7 +137,7 @@ impl Extent {
 
     #[inline]
     fn add(&mut self, r: &PrimRef) {
-        self.geom.grow(r.min, r.max);
+        self.geom.grow(r.min(), r.max);
         let c = r.centroid();
         self.cent.grow(c, c);
     }
@@ -171,11 +199,12 @@ pub(super) fn build<P: Primitives + ?Sized>(prims: &P, method: SplitMethod, opts
     if n == 0 {
         return (Vec::new(), Vec::new());
     }
+    assert!(n < MAX_PRIMS, "BVH: more than 2^30 primitives");
     let mut refs: Vec<PrimRef> = (0..n as u32)
         .into_par_iter()
         .map(|i| {
             let b = prims.bounds(i);
-            PrimRef { min: b.min.into(), max: b.max.into(), id: i }
+            PrimRef::new(b.min.into(), b.max.into(), i)
         })
         .collect();
     let ctx = Ctx { method, sah: SahCost::from_options(opts), max_leaf: opts.max_leaf_size.max(1), bins: opts.bins.clamp(2, 256), block: opts.leaf_block.max(1) };
@@ -184,7 +213,7 @@ pub(super) fn build<P: Primitives + ?Sized>(prims: &P, method: SplitMethod, opts
     let mut nodes: Vec<BvhNode> = (0..1 + root.descendants()).into_par_iter().map(|_| BvhNode::interior(Aabb::EMPTY, 0)).collect();
     let (top, below) = nodes.split_at_mut(1);
     top[0] = flatten(root, 1, below);
-    (nodes, refs.par_iter().map(|r| r.id).collect())
+    (nodes, refs.par_iter().map(PrimRef::id).collect())
 }
 
 /// Lays out `node`'s subtree depth-first with siblings adjacent in `below` (whose first
@@ -407,7 +436,7 @@ impl Bins {
             for (axis, t) in t.into_iter().enumerate() {
                 // SAFETY: `t` is in [0, nb - 1] (a NaN became 0 at `max`), so it converts.
                 let k = axis * nb + unsafe { t.to_int_unchecked::<u32>() } as usize;
-                self.bounds[k].grow(r.min, r.max);
+                self.bounds[k].grow(r.min(), r.max);
                 self.count[k] += 1;
             }
         }
@@ -524,7 +553,7 @@ mod tests {
         let input: Vec<PrimRef> = (0..n as u32)
             .map(|id| {
                 let min = Vec3A::new(next(), next(), next()) * 100.0;
-                PrimRef { min, max: min + Vec3A::new(next(), next(), next()), id }
+                PrimRef::new(min, min + Vec3A::new(next(), next(), next()), id)
             })
             .collect();
         for cut in [-1.0, 30.0, 50.0, 101.0] {
@@ -533,10 +562,10 @@ mod tests {
             let (m, le, re) = partition_parallel(&mut refs, left);
             let mut serial = input.clone();
             let (ms, les, res) = partition_serial(&mut serial, left, &mut Vec::new());
-            assert!(serial.iter().map(|r| r.id).eq(refs.iter().map(|r| r.id)) && ms == m, "cut {cut}: the serial partition's order");
+            assert!(serial.iter().map(PrimRef::id).eq(refs.iter().map(PrimRef::id)) && ms == m, "cut {cut}: the serial partition's order");
             assert!(extents_equal(&les, &le) && extents_equal(&res, &re));
-            let want: Vec<u32> = input.iter().filter(|r| left(r)).chain(input.iter().filter(|r| !left(r))).map(|r| r.id).collect();
-            assert_eq!(refs.iter().map(|r| r.id).collect::<Vec<_>>(), want, "cut {cut}");
+            let want: Vec<u32> = input.iter().filter(|r| left(r)).chain(input.iter().filter(|r| !left(r))).map(PrimRef::id).collect();
+            assert_eq!(refs.iter().map(PrimRef::id).collect::<Vec<_>>(), want, "cut {cut}");
             assert_eq!(m, input.iter().filter(|r| left(r)).count());
             let bound = |part: &[PrimRef]| part.iter().fold(Extent::EMPTY, |mut e, r| {
                 e.add(r);
