@@ -250,15 +250,16 @@ fn flatten(node: BuildNode, base: usize, below: &mut [BvhNode]) -> BvhNode {
 /// thread of its own rather than once per node.
 struct Scratch {
     bins: Bins,
-    right_area: Vec<f32>,
+    /// Per plane, the right side's primitives and its area times their test count.
     right_count: Vec<usize>,
+    right_cost: Vec<f32>,
     /// The right side of a serial partition, on its way to the back.
     rights: Vec<PrimRef>,
 }
 
 impl Scratch {
     fn new(nb: usize) -> Self {
-        Self { bins: Bins::new(nb), right_area: vec![0.0; nb], right_count: vec![0; nb], rights: Vec::new() }
+        Self { bins: Bins::new(nb), right_count: vec![0; nb], right_cost: vec![0.0; nb], rights: Vec::new() }
     }
 }
 
@@ -347,10 +348,15 @@ impl Ctx {
             });
             *bins = parts.reduce(|| Bins::new(nb), Bins::merge);
         }
-        let (right_area, right_count) = (&mut scratch.right_area, &mut scratch.right_count);
+        let (right_count, right_cost) = (&mut scratch.right_count, &mut scratch.right_cost);
+        // Planes are compared by their children's area-weighted test counts, `x`; the
+        // parent's area and the constants enter once, for the best. A flat parent (zero
+        // area): every ray that hits it hits both children, so they weigh 1 each.
         let pa = extent.geom.half_area();
-        // The cheapest plane so far: (cost, axis, plane); `axis == 3` while there is none.
-        let (mut best_cost, mut best_axis, mut best_plane) = (f32::INFINITY, 3, 0);
+        let flat = pa <= 0.0;
+        let weight = |b: &Box3| if flat { 1.0 } else { b.half_area() };
+        // The cheapest plane so far: (x, axis, plane); `axis == 3` while there is none.
+        let (mut best_x, mut best_axis, mut best_plane) = (f32::INFINITY, 3, 0);
         for axis in 0..3 {
             if scale[axis] == 0.0 {
                 continue;
@@ -360,8 +366,8 @@ impl Ctx {
             for p in (1..nb).rev() {
                 acc = acc.union(bin_bounds[p]);
                 cnt += bin_count[p];
-                right_area[p] = acc.half_area();
                 right_count[p] = cnt;
+                right_cost[p] = weight(&acc) * self.blocks(cnt);
             }
             let (mut acc, mut cnt) = (Box3::EMPTY, 0);
             for p in 1..nb {
@@ -370,16 +376,13 @@ impl Ctx {
                 if cnt == 0 || right_count[p] == 0 {
                     continue;
                 }
-                let cost = if pa > 0.0 {
-                    self.sah.traversal + self.sah.intersection * (acc.half_area() * self.blocks(cnt) + right_area[p] * self.blocks(right_count[p])) / pa
-                } else {
-                    self.sah.traversal + self.sah.intersection * (self.blocks(cnt) + self.blocks(right_count[p]))
-                };
-                if best_axis == 3 || cost < best_cost {
-                    (best_cost, best_axis, best_plane) = (cost, axis, p);
+                let x = weight(&acc) * self.blocks(cnt) + right_cost[p];
+                if best_axis == 3 || x < best_x {
+                    (best_x, best_axis, best_plane) = (x, axis, p);
                 }
             }
         }
+        let best_cost = self.sah.traversal + self.sah.intersection * if flat { best_x } else { best_x / pa };
         let (axis, plane) = (best_axis, best_plane);
         if axis == 3 || (best_cost >= self.sah.intersection * self.blocks(refs.len()) && refs.len() <= self.max_leaf) {
             return None;
@@ -432,10 +435,10 @@ impl Bins {
     fn add(&mut self, refs: &[PrimRef], nb: usize, lo: Vec3A, scale: Vec3A) {
         let top = Vec3A::splat((nb - 1) as f32);
         for r in refs {
-            let t = ((r.centroid() - lo) * scale).max(Vec3A::ZERO).min(top).to_array();
-            for (axis, t) in t.into_iter().enumerate() {
-                // SAFETY: `t` is in [0, nb - 1] (a NaN became 0 at `max`), so it converts.
-                let k = axis * nb + unsafe { t.to_int_unchecked::<u32>() } as usize;
+            // In [0, nb - 1]: a NaN became 0 at `max`.
+            let bin = truncate(((r.centroid() - lo) * scale).max(Vec3A::ZERO).min(top));
+            for (axis, b) in bin.into_iter().enumerate() {
+                let k = axis * nb + b as usize;
                 self.bounds[k].grow(r.min(), r.max);
                 self.count[k] += 1;
             }
@@ -451,6 +454,21 @@ impl Bins {
         }
         self
     }
+}
+
+/// The whole parts of `t`'s lanes, each in `[0, 2³¹)`: one conversion for the three axes.
+#[inline(always)]
+fn truncate(t: Vec3A) -> [u32; 3] {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{__m128, _mm_cvttps_epi32};
+        // SAFETY: SSE2 is in the x86-64 baseline; the result holds four i32.
+        let [x, y, z, _]: [i32; 4] = unsafe { std::mem::transmute(_mm_cvttps_epi32(__m128::from(t))) };
+        [x as u32, y as u32, z as u32]
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    // SAFETY: each lane is in [0, 2³¹), so it converts.
+    t.to_array().map(|v| unsafe { v.to_int_unchecked::<u32>() })
 }
 
 /// Moves the primitives for which `left` holds to the front, both sides in their input
@@ -540,6 +558,20 @@ mod tests {
     fn extents_equal(a: &Extent, b: &Extent) -> bool {
         let eq = |x: &Box3, y: &Box3| x.min == y.min && x.max == y.max;
         eq(&a.geom, &b.geom) && eq(&a.cent, &b.cent)
+    }
+
+    /// An index survives the trip through the fourth lane, whose float stays normal (no
+    /// denormal in the centroid's arithmetic), and the box lanes are untouched.
+    #[test]
+    fn prim_refs_carry_their_index_in_a_normal_float() {
+        let (min, max) = (Vec3A::new(-1.0, 2.0, -3.5), Vec3A::new(4.0, 5.0, 6.0));
+        for id in [0, 1, 7, (1 << 23) - 1, 1 << 23, 123_456_789, MAX_PRIMS as u32 - 1] {
+            let r = PrimRef::new(min, max, id);
+            assert_eq!(r.id(), id);
+            assert!(r.min_id.w.is_normal() && r.min_id.w.is_finite(), "id {id}: {}", r.min_id.w);
+            assert_eq!((r.min(), r.max), (min, max));
+            assert_eq!(r.centroid(), Vec3A::new(1.5, 3.5, 1.25));
+        }
     }
 
     /// Both partitions are the stable one: lefts then rights, each in input order, with the
