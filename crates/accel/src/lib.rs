@@ -248,20 +248,16 @@ pub(crate) fn leaf_margin(scene: &Aabb) -> f32 {
     (scene.extent().max_element() * (1.0 / 262_144.0)).max(f32::MIN_POSITIVE)
 }
 
-/// The binary BVH of `opts.quality`, named `name` (the user's choice, whatever the builder).
-fn binary_at_quality<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions, name: &'static str) -> Bvh {
-    build_binary(prims, opts, name)
-}
-
 /// The binary BVH a wide layout is converted from: [`binary_at_quality`], with the binned
-/// SAH counting in the leaves' blocks of four ([`BuildOptions::leaf_block`]) when every
-/// primitive is a triangle. Other primitives are tested one call each, whatever block
-/// they share, so there a leaf's cost stays one per primitive.
+/// SAH counting in the leaves' blocks of four ([`BuildOptions::leaf_block`]) and binary
+/// leaves of at most four when every primitive is a triangle. Other primitives are tested
+/// one call each, whatever block they share, so there a leaf's cost stays one per
+/// primitive.
 pub fn binary_for_wide<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions, name: &'static str) -> Bvh {
     if !all_triangles(prims) {
-        return build_binary(prims, opts, name);
+        return binary_at_quality(prims, opts, name);
     }
-    build_binary(prims, &BuildOptions { leaf_block: 4, max_leaf_size: opts.max_leaf_size.min(4), ..opts.clone() }, name)
+    binary_at_quality(prims, &BuildOptions { leaf_block: 4, max_leaf_size: opts.max_leaf_size.min(4), ..opts.clone() }, name)
 }
 
 fn all_triangles<P: Primitives + ?Sized>(prims: &P) -> bool {
@@ -269,7 +265,8 @@ fn all_triangles<P: Primitives + ?Sized>(prims: &P) -> bool {
     (0..prims.len() as u32).into_par_iter().with_min_len(4096).all(|i| prims.is_triangle(i))
 }
 
-fn build_binary<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions, name: &'static str) -> Bvh {
+/// The binary BVH of `opts.quality`, named `name` (the user's choice, whatever the builder).
+fn binary_at_quality<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions, name: &'static str) -> Bvh {
     let mut bvh = match opts.quality {
         BuildQuality::Low => bvh::lbvh::build(prims, opts),
         BuildQuality::Medium => Bvh::build(prims, SplitMethod::BinnedSah, opts),
