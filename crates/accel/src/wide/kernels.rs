@@ -217,6 +217,15 @@ pub fn triangles_sse(b: &TriBlock, s: &ShearedRay, t_min: f32, t_max: f32) -> Bl
         let neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)), _mm_cmplt_ps(w, zero));
         let pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)), _mm_cmpgt_ps(w, zero));
         let outside = _mm_and_ps(neg, pos);
+        let prim = _mm_loadu_si128(b.prim.as_ptr().cast());
+        let empty = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(prim, _mm_set1_epi32(EMPTY as i32)))) as u32;
+        let other = _mm_movemask_ps(_mm_castsi128_ps(prim)) as u32 & !empty;
+        // Most blocks a ray reaches miss all four triangles: the edge functions alone say
+        // so, and the distance, its error bound and the division are skipped. (A lane that
+        // is not a triangle is never skipped, whatever its vertices.)
+        if (_mm_movemask_ps(_mm_andnot_ps(undecided_edges, outside)) as u32 & !other | empty) == 0xF {
+            return BlockHits { hit: 0, exact: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
+        }
         let det = _mm_add_ps(_mm_add_ps(u, v), w);
         let (az, bz, cz) = (_mm_mul_ps(sz, az), _mm_mul_ps(sz, bz), _mm_mul_ps(sz, cz));
         let t_scaled = _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, az), _mm_mul_ps(v, bz)), _mm_mul_ps(w, cz));
@@ -247,9 +256,6 @@ pub fn triangles_sse(b: &TriBlock, s: &ShearedRay, t_min: f32, t_max: f32) -> Bl
         let in_range = _mm_and_ps(_mm_cmpgt_ps(t, _mm_set1_ps(t_min)), _mm_cmple_ps(t, _mm_set1_ps(t_max)));
         let hit = _mm_andnot_ps(_mm_or_ps(undecided_edges, rejected), _mm_and_ps(_mm_and_ps(finite, ahead), in_range));
         let exact = _mm_or_ps(undecided_edges, _mm_andnot_ps(_mm_or_ps(rejected, decided_t), _mm_set1_ps(f32::from_bits(u32::MAX))));
-        let prim = _mm_loadu_si128(b.prim.as_ptr().cast());
-        let empty = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(prim, _mm_set1_epi32(EMPTY as i32)))) as u32;
-        let other = _mm_movemask_ps(_mm_castsi128_ps(prim)) as u32 & !empty;
         let mut out = BlockHits { hit: (_mm_movemask_ps(hit) as u32) & !empty & !other, exact: ((_mm_movemask_ps(exact) as u32) | other) & !empty, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
         _mm_storeu_ps(out.t.as_mut_ptr(), t);
         _mm_storeu_ps(out.u.as_mut_ptr(), _mm_mul_ps(v, inv_det));

@@ -182,9 +182,11 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
     if bvh.root == EMPTY {
         return None;
     }
+    // The per-ray constants are read from the caller's ray, not from the copy below: a
+    // load of a few lanes out of a just-stored 32-byte copy misses store forwarding.
+    let rb = RayBoxes::new(ray);
+    let s = ShearedRay::new(ray);
     let mut ray = *ray;
-    let rb = RayBoxes::new(&ray);
-    let s = ShearedRay::new(&ray);
     let mut best = None;
     let mut w = Work::default();
     let mut stack = [const { MaybeUninit::<Entry>::uninit() }; STACK];
