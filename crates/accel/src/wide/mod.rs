@@ -8,13 +8,16 @@
 //! - `collapse.rs`: binary → wide, by a cost-driven programme (Ylitie et al. 2017);
 //! - `kernels.rs`: box and triangle kernels, SIMD and portable with identical answers;
 //! - `traverse.rs`: closest and any hit, counting or not;
-//! - `packet.rs`: closest hits of 16-ray packets (4×4 tiles of camera rays).
+//! - `packet.rs`: closest hits of 16-ray packets (4×4 tiles of camera rays), child-major;
+//! - `ray_major.rs`: the same with AVX-512, one ray per lane (Embree's `rtcIntersect16`).
 
 mod collapse;
 pub mod kernels;
 pub mod node;
 mod packet;
 pub mod quant;
+#[cfg(target_arch = "x86_64")]
+mod ray_major;
 mod traverse;
 
 use rayon::prelude::*;
@@ -139,6 +142,13 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
     #[inline]
     fn packet_dispatch<P: Primitives + ?Sized, const COUNT: bool>(&self, prims: &P, rays: &[Ray], out: &mut [Option<Hit>], c: &mut Counters) {
         #[cfg(target_arch = "x86_64")]
+        if W == 8 && self.kernel != Kernel::Portable && !rays.is_empty() && rays.len() <= PACKET && out.len() == rays.len() && ray_major_available() {
+            // SAFETY: the features were detected.
+            if unsafe { ray_major::closest::<P, W, N, COUNT>(self, prims, rays, out, c) } {
+                return;
+            }
+        }
+        #[cfg(target_arch = "x86_64")]
         match self.kernel {
             // SAFETY: `Kernel::Avx512` is only chosen after detecting its features.
             Kernel::Avx512 => return unsafe { packet_avx512::<P, W, N, COUNT>(self, prims, rays, out, c) },
@@ -239,6 +249,13 @@ fn encode<const W: usize, N: Layout<W>>(nodes: &[WideNode<W>], root: ChildRef) -
     }
     // Nodes no traversal reaches (validation reports them) keep their own boxes.
     out.into_iter().zip(nodes).map(|(e, n)| e.unwrap_or_else(|| N::encode(n))).collect()
+}
+
+/// Whether this CPU runs the ray-major packet path ([`ray_major`]): AVX-512F and VL.
+#[cfg(target_arch = "x86_64")]
+fn ray_major_available() -> bool {
+    use std::is_x86_feature_detected as has;
+    has!("avx512f") && has!("avx512vl") && has!("avx2") && has!("bmi1") && has!("bmi2")
 }
 
 /// The AVX2 instantiations: the whole traversal is compiled with AVX2 so that the box

@@ -128,7 +128,7 @@ fn block_any<P: Primitives + ?Sized, const SIMD: bool>(b: &TriBlock, prims: &P, 
 /// double-precision fallbacks, or the primitive's own test. Kept out of line: the
 /// traversal's registers are spilled only on this (with SIMD, rare) path.
 #[inline(never)]
-fn exact_lane<P: Primitives + ?Sized>(b: &TriBlock, l: usize, prims: &P, s: &ShearedRay, ray: &Ray) -> Option<PrimHit> {
+pub(super) fn exact_lane<P: Primitives + ?Sized>(b: &TriBlock, l: usize, prims: &P, s: &ShearedRay, ray: &Ray) -> Option<PrimHit> {
     let p = b.prim[l];
     if p & TriBlock::OTHER != 0 {
         prims.intersect(p & !TriBlock::OTHER, ray)

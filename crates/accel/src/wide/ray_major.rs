@@ -1,0 +1,606 @@
+//! Closest hits of a 16-ray packet with AVX-512, ray-major as Embree's `rtcIntersect16`:
+//! ray `r` lives in lane `r` of every 512-bit register, and a node's child box (or a
+//! leaf's triangle) is broadcast and tested against all sixteen rays at once. The
+//! child-major path (`packet.rs`) runs each ray's 8-wide box test in turn instead, and
+//! transposes the answers into per-child ray masks.
+//!
+//! Each lane does the single-ray kernels' IEEE operations in the same order (the slab test
+//! of [`slabs_avx2`](super::kernels::slabs_avx2), the watertight test of
+//! [`triangles_sse`](super::kernels::triangles_sse)), and hits are kept as the least
+//! `(t, prim)` as in [`wins`](super::traverse::wins), so every ray gets exactly its
+//! single-ray answer. A stack entry carries each ray's entry distance into the child
+//! (infinity for rays that did not enter it), so a pop drops exactly the rays whose hit so
+//! far lies nearer, ray by ray.
+//!
+//! It needs the packet's rays to share their direction signs (the box rows they read) and
+//! their shear axes (the triangle coordinates they read): camera tiles nearly always do.
+//! [`closest`] declines other packets, and the caller takes the child-major path.
+
+use std::arch::x86_64::*;
+use std::mem::MaybeUninit;
+
+use raylab_core::intersect::ShearedRay;
+use raylab_core::{gamma, Ray};
+
+use super::kernels::ROBUST_FAR;
+use super::node::{is_leaf, Layout, TriBlock, WideNode, EMPTY};
+use super::packet::PACKET;
+use super::traverse::{exact_lane, leaf_slice, occupied, STACK};
+use super::WideBvh;
+use crate::{Counters, Hit, Primitives};
+
+/// Sixteen lanes, aligned for 512-bit loads and stores.
+#[derive(Clone, Copy)]
+#[repr(C, align(64))]
+struct Lanes([f32; PACKET]);
+
+/// The packet's per-ray constants, one lane per ray, and what its rays share.
+struct Packet {
+    origin: [__m512; 3],
+    inv: [__m512; 3],
+    inv_far: [__m512; 3],
+    t_min: __m512,
+    /// Shear `d[kx]/d[kz]`, `d[ky]/d[kz]` and scale `1/d[kz]`.
+    shear: [__m512; 3],
+    /// `RayBoxes::near` and `far` of every ray.
+    near_rows: [usize; 3],
+    far_rows: [usize; 3],
+    /// `(kx, ky, kz)` of every ray's `ShearedRay`.
+    axes: (usize, usize, usize),
+}
+
+impl Packet {
+    /// The constants of `rays` (1 to [`PACKET`]; lanes past their count repeat the last
+    /// ray), computed as `RayBoxes::new` and `ShearedRay::new` do ray by ray, and their
+    /// `t_max`; `None` unless they share box rows and shear axes.
+    #[target_feature(enable = "avx2,avx512f,avx512vl")]
+    fn new(rays: &[Ray]) -> Option<(Packet, __m512)> {
+        let n = rays.len();
+        // The rays' origins, directions and intervals, one lane per ray; lanes past `n` repeat
+        // the last ray and are never active.
+        let mut lanes = [Lanes([0.0; PACKET]); 8];
+        for r in 0..PACKET {
+            let ray = &rays[r.min(n - 1)];
+            for a in 0..3 {
+                (lanes[a].0[r], lanes[3 + a].0[r]) = (ray.origin[a], ray.dir[a]);
+            }
+            (lanes[6].0[r], lanes[7].0[r]) = (ray.t_min, ray.t_max);
+        }
+        // SAFETY: `Lanes` is 64-byte aligned.
+        let v = |i: usize| unsafe { _mm512_load_ps(lanes[i].0.as_ptr()) };
+        let (origin, dir, t_min, t_max) = ([v(0), v(1), v(2)], [v(3), v(4), v(5)], v(6), v(7));
+        let zero = _mm512_setzero_ps();
+        let one = _mm512_set1_ps(1.0);
+        // `RayBoxes::new` lane by lane: the near rows must agree.
+        let inv = dir.map(|d| _mm512_div_ps(one, _mm512_add_ps(d, zero)));
+        let negative = inv.map(|i| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(i, zero));
+        if negative.iter().any(|&m| m != 0 && m != 0xFFFF) {
+            return None;
+        }
+        let near_rows = [0, 1, 2].map(|a| if negative[a] != 0 { 3 + a } else { a });
+        let far_rows = [0, 1, 2].map(|a| if negative[a] != 0 { a } else { 3 + a });
+        // `ShearedRay::new` lane by lane: the axes must agree.
+        #[allow(clippy::redundant_closure)] // a `#[target_feature]` fn is not `FnMut`
+        let ad = dir.map(|d| _mm512_abs_ps(d));
+        let gt = |a: usize, b: usize| _mm512_cmp_ps_mask::<_CMP_GT_OQ>(ad[a], ad[b]);
+        let (x0, z0, yz) = (gt(0, 1), gt(0, 2), gt(1, 2));
+        let (along_x, along_y) = (x0 & z0, !x0 & yz);
+        let kz = match (along_x, along_y) {
+            (0xFFFF, _) => 0,
+            (_, 0xFFFF) => 1,
+            (0, 0) => 2,
+            _ => return None,
+        };
+        let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        match _mm512_cmp_ps_mask::<_CMP_LT_OQ>(dir[kz], zero) {
+            0 => {}
+            0xFFFF => std::mem::swap(&mut kx, &mut ky),
+            _ => return None,
+        }
+        let robust_far = _mm512_set1_ps(ROBUST_FAR);
+        let shear = [_mm512_div_ps(dir[kx], dir[kz]), _mm512_div_ps(dir[ky], dir[kz]), _mm512_div_ps(one, dir[kz])];
+        Some((Packet { origin, inv, inv_far: inv.map(|i| _mm512_mul_ps(i, robust_far)), t_min, shear, near_rows, far_rows, axes: (kx, ky, kz) }, t_max))
+    }
+}
+
+/// What each ray has found so far: its `t_max` (the best hit's distance once it has one),
+/// the best primitive (`u32::MAX` for none) and its barycentrics.
+struct Best {
+    t: __m512,
+    prim: __m512i,
+    u: __m512,
+    v: __m512,
+}
+
+/// Closest hits of `rays` (1 to [`PACKET`]) into `out` (as long as `rays`); `false`, with
+/// `out` and `c` untouched, for a packet whose rays do not share their box rows and shear
+/// axes. Counting (`COUNT`) charges as the child-major path does: each node once per
+/// active ray, each block's occupied lanes once per ray tested against it.
+///
+/// # Safety
+/// The CPU must support AVX-512F and VL, AVX2, BMI1 and BMI2.
+#[target_feature(enable = "avx2,avx512f,avx512vl,bmi1,bmi2")]
+pub(super) unsafe fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, rays: &[Ray], out: &mut [Option<Hit>], c: &mut Counters) -> bool {
+    let n = rays.len();
+    debug_assert!((1..=PACKET).contains(&n) && out.len() == n);
+    let Some((p, t_max)) = Packet::new(rays) else { return false };
+    out.fill(None);
+    if COUNT {
+        c.rays += n as u64;
+    }
+    if bvh.root == EMPTY {
+        return true;
+    }
+    let (near_rows, far_rows, (kx, ky, kz)) = (p.near_rows, p.far_rows, p.axes);
+    let zero = _mm512_setzero_ps();
+    let mut best = Best { t: t_max, prim: _mm512_set1_epi32(-1), u: zero, v: zero };
+    let mut far = _mm512_mul_ps(best.t, _mm512_set1_ps(ROBUST_FAR));
+    let mut stack_node = [const { MaybeUninit::<u32>::uninit() }; STACK];
+    let mut stack_t = [const { MaybeUninit::<Lanes>::uninit() }; STACK];
+    let mut sp = 0usize;
+    let mut cur = bvh.root;
+    // Each ray's entry distance into `cur`: infinity for rays not in it.
+    let all: __mmask16 = if n == PACKET { 0xFFFF } else { (1 << n) - 1 };
+    let mut cur_t = _mm512_mask_blend_ps(all, _mm512_set1_ps(f32::INFINITY), p.t_min);
+    'walk: loop {
+        // Rays still in this subtree: entered it, and their hit so far is not nearer.
+        let active = _mm512_cmp_ps_mask::<_CMP_LE_OQ>(cur_t, far) & all;
+        if active != 0 {
+            if COUNT {
+                c.nodes_visited += u64::from(active.count_ones());
+            }
+            if is_leaf(cur) {
+                for b in leaf_slice(bvh, cur) {
+                    if COUNT {
+                        c.prim_tests += occupied(b) * u64::from(active.count_ones());
+                    }
+                    block(b, prims, rays, &p, (kx, ky, kz), active, &mut best);
+                }
+                far = _mm512_mul_ps(best.t, _mm512_set1_ps(ROBUST_FAR));
+            } else {
+                // Children any ray entered, nearest first by their rays' least entry
+                // distance (the child-major path's order, so a packet of copies walks as
+                // one ray does); the others wait on the stack with each ray's distance.
+                let lane_bits = W as u32 - 1;
+                let mut entry = [const { MaybeUninit::<Lanes>::uninit() }; W];
+                let mut keys = [0u32; W];
+                let mut k = 0;
+                bvh.nodes[cur as usize].with_decoded(|node| {
+                    #[allow(clippy::needless_range_loop)] // `l` indexes the child, its boxes and `entry`
+                    for l in 0..W {
+                        if node.child[l] == EMPTY {
+                            continue;
+                        }
+                        let (hit, t0) = slabs(node, l, &p, near_rows, far_rows, far, active);
+                        if hit == 0 {
+                            continue;
+                        }
+                        // SAFETY: as above; `Lanes` is 64-byte aligned.
+                        let key = unsafe {
+                            _mm512_store_ps(entry[l].as_mut_ptr().cast(), _mm512_mask_blend_ps(hit, _mm512_set1_ps(f32::INFINITY), t0));
+                            (_mm512_mask_reduce_min_ps(hit, t0).to_bits() & !lane_bits) | l as u32
+                        };
+                        let mut j = k;
+                        while j > 0 && keys[j - 1] > key {
+                            keys[j] = keys[j - 1];
+                            j -= 1;
+                        }
+                        keys[j] = key;
+                        k += 1;
+                    }
+                });
+                if k > 0 {
+                    let node = &bvh.nodes[cur as usize];
+                    for &key in keys[1..k].iter().rev() {
+                        let l = (key & lane_bits) as usize;
+                        stack_node[sp] = MaybeUninit::new(node.child(l));
+                        stack_t[sp] = entry[l];
+                        sp += 1;
+                    }
+                    let l = (keys[0] & lane_bits) as usize;
+                    cur = node.child(l);
+                    // SAFETY: the entries of entered lanes were stored above; `Lanes` is aligned.
+                    cur_t = unsafe { _mm512_load_ps(entry[l].as_ptr().cast()) };
+                    continue 'walk;
+                }
+            }
+        }
+        if sp == 0 {
+            break;
+        }
+        sp -= 1;
+        // SAFETY: entries below `sp` were written by the pushes above; `Lanes` is aligned.
+        (cur, cur_t) = unsafe { (stack_node[sp].assume_init(), _mm512_load_ps(stack_t[sp].assume_init_ref().0.as_ptr())) };
+    }
+    let mut t = Lanes([0.0; PACKET]);
+    let mut u = Lanes([0.0; PACKET]);
+    let mut v = Lanes([0.0; PACKET]);
+    let mut prim = [0u32; PACKET];
+    // SAFETY: `Lanes` is 64-byte aligned, and every array holds 16 lanes of 4 bytes.
+    unsafe {
+        _mm512_store_ps(t.0.as_mut_ptr(), best.t);
+        _mm512_store_ps(u.0.as_mut_ptr(), best.u);
+        _mm512_store_ps(v.0.as_mut_ptr(), best.v);
+        _mm512_storeu_si512(prim.as_mut_ptr().cast(), best.prim);
+    }
+    for (r, o) in out.iter_mut().enumerate() {
+        if prim[r] != u32::MAX {
+            *o = Some(Hit { t: t.0[r], prim: prim[r], u: u.0[r], v: v.0[r] });
+        }
+    }
+    true
+}
+
+/// Child `l` of `node` against the `active` rays: the rays entering it (within each ray's
+/// `far` limit) and their entry distances, as [`slabs_avx2`](super::kernels::slabs_avx2)
+/// computes them for each ray.
+#[inline]
+#[target_feature(enable = "avx2,avx512f,avx512vl")]
+fn slabs<const W: usize>(node: &WideNode<W>, l: usize, p: &Packet, near_rows: [usize; 3], far_rows: [usize; 3], far: __m512, active: __mmask16) -> (__mmask16, __m512) {
+    let mut t0 = p.t_min;
+    let mut t1 = far;
+    for a in 0..3 {
+        let lo = _mm512_set1_ps(node.bounds[near_rows[a]][l]);
+        let hi = _mm512_set1_ps(node.bounds[far_rows[a]][l]);
+        let near = _mm512_mul_ps(_mm512_sub_ps(lo, p.origin[a]), p.inv[a]);
+        let far = _mm512_mul_ps(_mm512_sub_ps(hi, p.origin[a]), p.inv_far[a]);
+        // As in the single-ray kernel: `max(a, b)` returns `b` when either is NaN.
+        t0 = _mm512_max_ps(near, t0);
+        t1 = _mm512_min_ps(far, t1);
+    }
+    (_mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(active, t0, t1), t0)
+}
+
+/// The triangles of block `b` against the `active` rays, updating each ray's best hit; a
+/// lane the SIMD arithmetic cannot decide, or that is not a triangle, goes through the
+/// exact scalar kernel ray by ray, as in single-ray traversal.
+#[inline]
+#[target_feature(enable = "avx2,avx512f,avx512vl,bmi1,bmi2")]
+#[allow(clippy::too_many_arguments)]
+fn block<P: Primitives + ?Sized>(b: &TriBlock, prims: &P, rays: &[Ray], p: &Packet, (kx, ky, kz): (usize, usize, usize), active: __mmask16, best: &mut Best) {
+    for j in 0..4 {
+        let prim = b.prim[j];
+        if prim == EMPTY {
+            continue;
+        }
+        let (hit, exact, t, u, v) = if prim & TriBlock::OTHER != 0 { (0, active, _mm512_setzero_ps(), _mm512_setzero_ps(), _mm512_setzero_ps()) } else { triangle(b, j, p, (kx, ky, kz), active, best.t) };
+        if hit != 0 {
+            keep(best, hit, t, u, v, prim);
+        }
+        let mut m = exact;
+        while m != 0 {
+            let r = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let mut t_max = Lanes([0.0; PACKET]);
+            let mut best_prim = [0u32; PACKET];
+            // SAFETY: `Lanes` is 64-byte aligned; both arrays hold 16 lanes of 4 bytes.
+            unsafe {
+                _mm512_store_ps(t_max.0.as_mut_ptr(), best.t);
+                _mm512_storeu_si512(best_prim.as_mut_ptr().cast(), best.prim);
+            }
+            let ray = Ray { t_max: t_max.0[r], ..rays[r] };
+            let id = prim & !TriBlock::OTHER;
+            let first = best_prim[r] == u32::MAX;
+            if let Some(x) = exact_lane(b, j, prims, &ShearedRay::new(&ray), &ray).filter(|x| x.t <= ray.t_max && (first || x.t < ray.t_max || id < best_prim[r])) {
+                keep(best, 1 << r, _mm512_set1_ps(x.t), _mm512_set1_ps(x.u), _mm512_set1_ps(x.v), id);
+            }
+        }
+    }
+}
+
+/// Makes `(t, prim)` the best hit of the rays in `hit` where it wins: nearer, or as near
+/// and a lower primitive ([`wins`](super::traverse::wins)).
+#[inline]
+#[target_feature(enable = "avx2,avx512f,avx512vl")]
+fn keep(best: &mut Best, hit: __mmask16, t: __m512, u: __m512, v: __m512, prim: u32) {
+    let id = _mm512_set1_epi32(prim as i32);
+    let nearer = _mm512_mask_cmp_ps_mask::<_CMP_LT_OQ>(hit, t, best.t);
+    let tie = _mm512_mask_cmp_ps_mask::<_CMP_EQ_OQ>(hit, t, best.t) & _mm512_cmplt_epu32_mask(id, best.prim);
+    let win = nearer | tie;
+    best.t = _mm512_mask_blend_ps(win, best.t, t);
+    best.u = _mm512_mask_blend_ps(win, best.u, u);
+    best.v = _mm512_mask_blend_ps(win, best.v, v);
+    best.prim = _mm512_mask_blend_epi32(win, best.prim, id);
+}
+
+/// Triangle `j` of block `b` against the `active` rays: [`triangles_sse`]'s operations
+/// for one triangle and sixteen rays. Returns the rays hitting it within `(t_min, t_max]`
+/// with `t` and barycentrics, and the rays left to the exact scalar kernel.
+///
+/// [`triangles_sse`]: super::kernels::triangles_sse
+#[inline]
+#[target_feature(enable = "avx2,avx512f,avx512vl")]
+#[allow(clippy::type_complexity)]
+fn triangle(b: &TriBlock, j: usize, p: &Packet, (kx, ky, kz): (usize, usize, usize), active: __mmask16, t_max: __m512) -> (__mmask16, __mmask16, __m512, __m512, __m512) {
+    let [sx, sy, sz] = p.shear;
+    let (ox, oy, oz) = (p.origin[kx], p.origin[ky], p.origin[kz]);
+    let project = |v: usize| {
+        let az = _mm512_sub_ps(_mm512_set1_ps(b.p[v][kz][j]), oz);
+        let x = _mm512_sub_ps(_mm512_sub_ps(_mm512_set1_ps(b.p[v][kx][j]), ox), _mm512_mul_ps(sx, az));
+        let y = _mm512_sub_ps(_mm512_sub_ps(_mm512_set1_ps(b.p[v][ky][j]), oy), _mm512_mul_ps(sy, az));
+        (x, y, az)
+    };
+    let ((ax, ay, az), (bx, by, bz), (cx, cy, cz)) = (project(0), project(1), project(2));
+    let u = _mm512_sub_ps(_mm512_mul_ps(cx, by), _mm512_mul_ps(cy, bx));
+    let v = _mm512_sub_ps(_mm512_mul_ps(ax, cy), _mm512_mul_ps(ay, cx));
+    let w = _mm512_sub_ps(_mm512_mul_ps(bx, ay), _mm512_mul_ps(by, ax));
+    let zero = _mm512_setzero_ps();
+    let eq0 = |x: __m512| _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(x, zero);
+    let lt0 = |x: __m512| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(x, zero);
+    let gt0 = |x: __m512| _mm512_cmp_ps_mask::<_CMP_GT_OQ>(x, zero);
+    let undecided_edges = eq0(u) | eq0(v) | eq0(w) | _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(u, v) | _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(w, w);
+    let outside = (lt0(u) | lt0(v) | lt0(w)) & (gt0(u) | gt0(v) | gt0(w));
+    // Most rays reaching a leaf miss most of its triangles: the edge functions say so.
+    if active & !(outside & !undecided_edges) == 0 {
+        return (0, 0, zero, zero, zero);
+    }
+    let det = _mm512_add_ps(_mm512_add_ps(u, v), w);
+    let (az, bz, cz) = (_mm512_mul_ps(sz, az), _mm512_mul_ps(sz, bz), _mm512_mul_ps(sz, cz));
+    let t_scaled = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(u, az), _mm512_mul_ps(v, bz)), _mm512_mul_ps(w, cz));
+    let inv_det = _mm512_div_ps(_mm512_set1_ps(1.0), det);
+    let t = _mm512_mul_ps(t_scaled, inv_det);
+    let abs = _mm512_abs_ps;
+    let max3 = |a: __m512, b: __m512, c: __m512| _mm512_max_ps(_mm512_max_ps(abs(a), abs(b)), abs(c));
+    let (max_zt, max_xt, max_yt, max_e) = (max3(az, bz, cz), max3(ax, bx, cx), max3(ay, by, cy), max3(u, v, w));
+    let g = |n: u32| _mm512_set1_ps(gamma(n));
+    let delta_z = _mm512_mul_ps(g(3), max_zt);
+    let delta_x = _mm512_mul_ps(g(5), _mm512_add_ps(max_xt, max_zt));
+    let delta_y = _mm512_mul_ps(g(5), _mm512_add_ps(max_yt, max_zt));
+    let delta_e = _mm512_mul_ps(_mm512_set1_ps(2.0), _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(_mm512_mul_ps(g(2), max_xt), max_yt), _mm512_mul_ps(delta_y, max_xt)), _mm512_mul_ps(delta_x, max_yt)));
+    let delta_t = _mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(3.0), _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(_mm512_mul_ps(g(3), max_e), max_zt), _mm512_mul_ps(delta_e, max_zt)), _mm512_mul_ps(delta_z, max_e))), abs(inv_det));
+    let inf = _mm512_set1_ps(f32::INFINITY);
+    let finite = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(abs(t), inf) & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(abs(delta_t), inf);
+    let ahead = _mm512_cmp_ps_mask::<_CMP_GT_OQ>(t, delta_t);
+    let behind = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(t, _mm512_sub_ps(zero, delta_t));
+    let rejected = !undecided_edges & (outside | eq0(det));
+    let decided_t = finite & (ahead | behind);
+    let in_range = _mm512_cmp_ps_mask::<_CMP_GT_OQ>(t, p.t_min) & _mm512_cmp_ps_mask::<_CMP_LE_OQ>(t, t_max);
+    let hit = active & !(undecided_edges | rejected) & finite & ahead & in_range;
+    let exact = active & (undecided_edges | !(rejected | decided_t));
+    (hit, exact, t, _mm512_mul_ps(v, inv_det), _mm512_mul_ps(w, inv_det))
+}
+
+#[cfg(test)]
+mod tests {
+    use raylab_core::{Pcg32, Ray, Vec3};
+
+    use super::super::{node::WideNode, quant::QuantNode, WideBvh};
+    use super::PACKET;
+    use crate::{binary_for_wide, BuildOptions, Counters, PrimHit, Primitives};
+
+    /// Triangles (through the packed blocks) then spheres (lanes that are not triangles).
+    struct Mixed {
+        tris: Vec<[Vec3; 3]>,
+        spheres: Vec<(Vec3, f32)>,
+    }
+
+    impl Primitives for Mixed {
+        fn len(&self) -> usize {
+            self.tris.len() + self.spheres.len()
+        }
+        fn bounds(&self, i: u32) -> raylab_core::Aabb {
+            match self.triangle(i) {
+                Some(t) => raylab_core::Aabb::from_points(t),
+                None => {
+                    let (c, r) = self.spheres[i as usize - self.tris.len()];
+                    raylab_core::Aabb::new(c - r, c + r)
+                }
+            }
+        }
+        fn intersect(&self, i: u32, ray: &Ray) -> Option<PrimHit> {
+            match self.triangle(i) {
+                Some([a, b, c]) => raylab_core::intersect::triangle(ray, a, b, c).map(|(t, u, v)| PrimHit { t, u, v }),
+                None => {
+                    let (c, r) = self.spheres[i as usize - self.tris.len()];
+                    raylab_core::intersect::sphere(ray, c, r).map(|t| PrimHit { t, u: 0.0, v: 0.0 })
+                }
+            }
+        }
+        fn triangle(&self, i: u32) -> Option<[Vec3; 3]> {
+            self.tris.get(i as usize).copied()
+        }
+    }
+
+    /// Random small triangles, a grid of quads whose shared edges and vertices rays pass
+    /// through, a triangle repeated under three indices (exact ties: the lowest index
+    /// wins), zero-area triangles (the scalar kernel's cases), and spheres.
+    fn scene(rng: &mut Pcg32) -> Mixed {
+        let mut r = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0;
+        let mut tris: Vec<[Vec3; 3]> = (0..600).map(|_| {
+            let c = r();
+            [c, c + 0.2 * r(), c + 0.2 * r()]
+        }).collect();
+        for i in 0..8 {
+            for j in 0..8 {
+                let p = |a: i32, b: i32| Vec3::new((i + a) as f32 * 0.25 - 1.0, (j + b) as f32 * 0.25 - 1.0, 0.5);
+                tris.push([p(0, 0), p(1, 0), p(1, 1)]);
+                tris.push([p(0, 0), p(1, 1), p(0, 1)]);
+            }
+        }
+        let dup = [Vec3::new(-0.5, -0.5, -0.9), Vec3::new(0.5, -0.5, -0.9), Vec3::new(0.0, 0.5, -0.9)];
+        tris.extend([dup; 3]);
+        let p = r();
+        tris.extend([[p, p, p], [p, p + Vec3::X * 0.1, p + Vec3::X * 0.2]]);
+        let spheres = (0..40).map(|k| (r(), 0.05 + 0.0025 * k as f32)).collect();
+        Mixed { tris, spheres }
+    }
+
+    /// Packets of 1 to 16 rays from one origin in a narrow cone (a camera tile), some with
+    /// a `t_min` above zero or a short `t_max`, and some through grid vertices exactly.
+    fn packets(rng: &mut Pcg32, prims: &Mixed) -> Vec<Vec<Ray>> {
+        (0..400).map(|k| {
+            // Every eleventh packet leaves a point of a tilted triangle (hits at t within
+            // the error bound of zero, some decided by the scalar kernel).
+            let origin = if k % 11 == 0 {
+                let [a, b, c] = prims.tris[k];
+                a + 0.3 * (b - a) + 0.3 * (c - a)
+            } else {
+                Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 6.0 - 3.0
+            };
+            let aim = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) - 0.5;
+            let n = if k % 5 == 0 { 1 + k % PACKET } else { PACKET };
+            (0..n).map(|r| {
+                let target = if k % 11 == 0 { origin + Vec3::new((r % 4) as f32 - 1.5, (r / 4) as f32 - 1.5, if k % 2 == 0 { 2.0 } else { -2.0 }) } else if k % 7 == 0 { Vec3::new((r % 4) as f32 * 0.25 - 0.5, (r / 4) as f32 * 0.25 - 0.5, 0.5) } else { aim + Vec3::new((r % 4) as f32, (r / 4) as f32, 0.0) * 0.02 };
+                let mut ray = Ray::new(origin, target - origin);
+                if k % 3 == 0 {
+                    ray.t_min = 0.3;
+                }
+                if k % 4 == 1 {
+                    ray.t_max = 0.5 + r as f32 * 0.05;
+                }
+                ray
+            }).collect()
+        }).collect()
+    }
+
+    fn check<N: super::super::node::Layout<8>>(bvh: &WideBvh<8, N>, prims: &Mixed, packets: &[Vec<Ray>]) {
+        let (mut taken, mut hits) = (0, 0);
+        for (k, rays) in packets.iter().enumerate() {
+            let mut out = vec![None; rays.len()];
+            let mut counted = vec![None; rays.len()];
+            let mut c = Counters::default();
+            // SAFETY: the caller checked AVX-512F and VL, AVX2, BMI1 and BMI2.
+            let took = unsafe { super::closest::<_, 8, N, false>(bvh, prims, rays, &mut out, &mut Counters::default()) };
+            // SAFETY: as above.
+            assert_eq!(unsafe { super::closest::<_, 8, N, true>(bvh, prims, rays, &mut counted, &mut c) }, took);
+            if !took {
+                assert!(out.iter().all(Option::is_none), "packet {k}: declined, yet answers written");
+                continue;
+            }
+            taken += 1;
+            for (r, ray) in rays.iter().enumerate() {
+                let want = super::super::traverse::closest::<_, 8, N, true, false>(bvh, prims, ray, &mut Counters::default());
+                assert_eq!(out[r], want, "packet {k} ray {r}");
+                assert_eq!(counted[r], want, "packet {k} ray {r}: counting build");
+                hits += usize::from(want.is_some());
+            }
+            assert_eq!(c.rays, rays.len() as u64, "packet {k}");
+            // Sixteen copies of a ray walk as the ray does alone: sixteen times its work.
+            let copies = [rays[0]; PACKET];
+            let (mut c16, mut c1) = (Counters::default(), Counters::default());
+            // SAFETY: as above.
+            assert!(unsafe { super::closest::<_, 8, N, true>(bvh, prims, &copies, &mut [None; PACKET], &mut c16) });
+            super::super::traverse::closest::<_, 8, N, true, true>(bvh, prims, &rays[0], &mut c1);
+            assert_eq!((c16.nodes_visited, c16.prim_tests), (16 * c1.nodes_visited, 16 * c1.prim_tests), "packet {k}: copies");
+        }
+        assert!(taken > 300 && hits > 2000, "too few packets through the ray-major path: {taken} packets, {hits} hits");
+    }
+
+    #[test]
+    fn coherent_packets_get_their_single_ray_answers() {
+        use std::is_x86_feature_detected as has;
+        if !(has!("avx512f") && has!("avx512vl") && has!("avx2") && has!("bmi1") && has!("bmi2")) {
+            eprintln!("no AVX-512 on this CPU: the ray-major path is not run");
+            return;
+        }
+        let mut rng = Pcg32::new(11, 3);
+        let prims = scene(&mut rng);
+        let packets = packets(&mut rng, &prims);
+        let binary = binary_for_wide(&prims, &BuildOptions::default(), "bvh");
+        check(&WideBvh::<8, WideNode<8>>::from_binary(&binary, &prims, "bvh8"), &prims, &packets);
+        check(&WideBvh::<8, QuantNode>::from_binary(&binary, &prims, "bvh8q"), &prims, &packets);
+    }
+
+    /// The ray-major triangle kernel decides each ray as `triangles_sse` decides that ray
+    /// alone: the same hits with the same bits of `t` and barycentrics, and the same rays
+    /// left to the scalar kernel. Random, degenerate, tiny and huge triangles, origins on
+    /// the triangles (t within the error bound of zero) and limited `t` ranges.
+    #[test]
+    fn the_triangle_kernel_matches_the_four_wide_kernel_ray_by_ray() {
+        use super::super::kernels::triangles_sse;
+        use super::super::node::TriBlock;
+        use raylab_core::intersect::ShearedRay;
+        use std::arch::x86_64::*;
+        use std::is_x86_feature_detected as has;
+        if !(has!("avx512f") && has!("avx512vl") && has!("avx2")) {
+            return;
+        }
+        let mut rng = Pcg32::new(13, 5);
+        let mut r = |scale: f32| Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, rng.next_f32() - 0.5) * scale;
+        let (mut hits, mut exact, mut packets) = (0, 0, 0);
+        for k in 0..6000 {
+            let scale = [1.0, 1e-30, 1e30, 3e38, 1e6][k % 5];
+            let mut b = TriBlock::EMPTY_BLOCK;
+            for l in 0..4 {
+                let v = match (k + l) % 6 {
+                    0 => [Vec3::ZERO; 3],
+                    1 => {
+                        let p = r(scale);
+                        [p, p, r(scale)]
+                    }
+                    _ => [r(scale), r(scale), r(scale)],
+                };
+                b.set_triangle(l, l as u32, v);
+            }
+            let origin = match k % 3 {
+                0 => r(2.0 * scale),
+                1 => Vec3::ZERO,
+                _ => b.vertex(2, 0) + 0.3 * (b.vertex(2, 1) - b.vertex(2, 0)) + 0.3 * (b.vertex(2, 2) - b.vertex(2, 0)),
+            };
+            let aim = (b.vertex(k % 4, 0) + b.vertex(k % 4, 1) + b.vertex(k % 4, 2)) / 3.0 - origin;
+            let rays: Vec<Ray> = (0..PACKET).map(|q| {
+                let d = aim + Vec3::new((q % 4) as f32 - 1.5, (q / 4) as f32 - 1.5, 0.0) * 0.01 * aim.length();
+                let mut ray = Ray::new(origin, if k % 11 == 0 { -d } else { d });
+                if k % 4 == 0 {
+                    ray.t_max = 0.9 + 0.01 * q as f32;
+                }
+                ray
+            }).collect();
+            // SAFETY: features checked above.
+            let Some((p, t_max)) = (unsafe { super::Packet::new(&rays) }) else { continue };
+            packets += 1;
+            let mut t_maxes = [0.0f32; PACKET];
+            // SAFETY: as above; the array holds 16 f32.
+            unsafe { _mm512_storeu_ps(t_maxes.as_mut_ptr(), t_max) };
+            for j in 0..4 {
+                // SAFETY: as above.
+                let (hit, ex, t, u, v) = unsafe { super::triangle(&b, j, &p, p.axes, 0xFFFF, t_max) };
+                let lanes = |x: __m512| {
+                    let mut a = [0.0f32; PACKET];
+                    // SAFETY: as above.
+                    unsafe { _mm512_storeu_ps(a.as_mut_ptr(), x) };
+                    a
+                };
+                let (t, u, v) = (lanes(t), lanes(u), lanes(v));
+                for (q, ray) in rays.iter().enumerate() {
+                    let one = triangles_sse(&b, &ShearedRay::new(ray), ray.t_min, t_maxes[q]);
+                    let bit = 1 << j;
+                    assert_eq!((hit >> q & 1 != 0, ex >> q & 1 != 0), (one.hit & bit != 0, one.exact & bit != 0), "block {k} triangle {j} ray {q}");
+                    if one.hit & bit != 0 {
+                        assert_eq!([t[q], u[q], v[q]].map(f32::to_bits), [one.t[j], one.u[j], one.v[j]].map(f32::to_bits), "block {k} triangle {j} ray {q}");
+                        hits += 1;
+                    }
+                    exact += usize::from(one.exact & bit != 0);
+                }
+            }
+        }
+        assert!(packets > 3000 && hits > 10000 && exact > 1000, "too few cases: {packets} packets, {hits} hits, {exact} left to the scalar kernel");
+    }
+
+    #[test]
+    fn packets_of_mixed_octants_or_axes_are_declined() {
+        use std::is_x86_feature_detected as has;
+        if !(has!("avx512f") && has!("avx512vl") && has!("avx2") && has!("bmi1") && has!("bmi2")) {
+            return;
+        }
+        let prims = Mixed { tris: vec![[Vec3::new(-1.0, -1.0, 2.0), Vec3::new(1.0, -1.0, 2.0), Vec3::new(0.0, 1.0, 2.0)]], spheres: vec![] };
+        let bvh = WideBvh::<8, WideNode<8>>::from_binary(&binary_for_wide(&prims, &BuildOptions::default(), "bvh"), &prims, "bvh8");
+        let run = |dirs: &[Vec3]| {
+            let rays: Vec<Ray> = dirs.iter().map(|&d| Ray::new(Vec3::ZERO, d)).collect();
+            let mut out = vec![None; rays.len()];
+            // SAFETY: features checked above.
+            let took = unsafe { super::closest::<_, 8, WideNode<8>, false>(&bvh, &prims, &rays, &mut out, &mut Counters::default()) };
+            (took, out)
+        };
+        // Along +z, all: taken, both hit at t = 2 (direction z = 1).
+        let (took, out) = run(&[Vec3::new(0.1, 0.1, 1.0), Vec3::new(0.2, 0.1, 1.0)]);
+        assert!(took);
+        assert_eq!(out.iter().map(|h| h.map(|h| (h.prim, h.t))).collect::<Vec<_>>(), [Some((0, 2.0)); 2]);
+        // One ray with a negative x: other box rows.
+        assert!(!run(&[Vec3::new(0.1, 0.1, 1.0), Vec3::new(-0.1, 0.1, 1.0)]).0);
+        // One ray mostly along x: other shear axes.
+        assert!(!run(&[Vec3::new(0.1, 0.1, 1.0), Vec3::new(2.0, 0.1, 1.0)]).0);
+        // Along -z for one: other signs and a swapped shear.
+        assert!(!run(&[Vec3::new(0.1, 0.1, 1.0), Vec3::new(0.1, 0.1, -1.0)]).0);
+    }
+}
