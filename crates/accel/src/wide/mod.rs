@@ -39,7 +39,9 @@ pub enum Kernel {
     Simd,
     /// The same intrinsics with the whole traversal compiled for AVX-512F/VL: 32 vector
     /// registers instead of 16 and mask registers for the compares. Same IEEE operations
-    /// in the same order, so the same answers. Opt-in: see [`Kernel::detect`].
+    /// in the same order, so the same answers. Packets of 8-wide nodes whose rays share box
+    /// rows and shear axes go ray-major, sixteen rays in the lanes of a 512-bit register
+    /// (`wide/ray_major.rs`). Opt-in: see [`Kernel::detect`].
     Avx512,
 }
 
@@ -142,8 +144,9 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
     #[inline]
     fn packet_dispatch<P: Primitives + ?Sized, const COUNT: bool>(&self, prims: &P, rays: &[Ray], out: &mut [Option<Hit>], c: &mut Counters) {
         #[cfg(target_arch = "x86_64")]
-        if W == 8 && self.kernel != Kernel::Portable && !rays.is_empty() && rays.len() <= PACKET && out.len() == rays.len() && ray_major_available() {
-            // SAFETY: the features were detected.
+        if W == 8 && self.kernel == Kernel::Avx512 && !rays.is_empty() && rays.len() <= PACKET && out.len() == rays.len() && ray_major_available() {
+            // SAFETY: the features were detected (`Kernel::Avx512` is only chosen after
+            // detecting them, and `ray_major_available` checks them again).
             if unsafe { ray_major::closest::<P, W, N, COUNT>(self, prims, rays, out, c) } {
                 return;
             }

@@ -22,10 +22,10 @@ use std::mem::MaybeUninit;
 use raylab_core::intersect::ShearedRay;
 use raylab_core::{gamma, Ray};
 
-use super::kernels::ROBUST_FAR;
+use super::kernels::{slabs_avx2, RayBoxes, ROBUST_FAR};
 use super::node::{is_leaf, Layout, TriBlock, WideNode, EMPTY};
 use super::packet::PACKET;
-use super::traverse::{exact_lane, leaf_slice, occupied, STACK};
+use super::traverse::{block_closest, exact_lane, leaf_slice, occupied, STACK};
 use super::WideBvh;
 use crate::{Counters, Hit, Primitives};
 
@@ -47,6 +47,23 @@ struct Packet {
     far_rows: [usize; 3],
     /// `(kx, ky, kz)` of every ray's `ShearedRay`.
     axes: (usize, usize, usize),
+    /// `origin`, `inv`, `inv_far`, `shear` and `t_min` stored lane by lane (13 rows).
+    each: [Lanes; 13],
+}
+
+impl Packet {
+    /// Ray `r`'s `RayBoxes`.
+    fn boxes(&self, r: usize) -> RayBoxes {
+        let e = |k: usize| self.each[k].0[r];
+        RayBoxes { origin: [e(0), e(1), e(2)], inv: [e(3), e(4), e(5)], inv_far: [e(6), e(7), e(8)], near: self.near_rows, far: self.far_rows, t_min: e(12) }
+    }
+
+    /// Ray `r`'s `ShearedRay`.
+    fn sheared(&self, r: usize) -> ShearedRay {
+        let e = |k: usize| self.each[k].0[r];
+        let (kx, ky, kz) = self.axes;
+        ShearedRay { origin: raylab_core::Vec3::new(e(0), e(1), e(2)), kx, ky, kz, sx: e(9), sy: e(10), sz: e(11) }
+    }
 }
 
 impl Packet {
@@ -99,7 +116,14 @@ impl Packet {
         }
         let robust_far = _mm512_set1_ps(ROBUST_FAR);
         let shear = [_mm512_div_ps(dir[kx], dir[kz]), _mm512_div_ps(dir[ky], dir[kz]), _mm512_div_ps(one, dir[kz])];
-        Some((Packet { origin, inv, inv_far: inv.map(|i| _mm512_mul_ps(i, robust_far)), t_min, shear, near_rows, far_rows, axes: (kx, ky, kz) }, t_max))
+        let inv_far = inv.map(|i| _mm512_mul_ps(i, robust_far));
+        // The same constants ray by ray, for nodes and leaves that few rays reach.
+        let mut each = [Lanes([0.0; PACKET]); 13];
+        for (k, x) in origin.iter().chain(&inv).chain(&inv_far).chain(&shear).chain([&t_min]).enumerate() {
+            // SAFETY: `Lanes` is 64-byte aligned.
+            unsafe { _mm512_store_ps(each[k].0.as_mut_ptr(), *x) };
+        }
+        Some((Packet { origin, inv, inv_far, t_min, shear, near_rows, far_rows, axes: (kx, ky, kz), each }, t_max))
     }
 }
 
@@ -150,11 +174,16 @@ pub(super) unsafe fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W
                 c.nodes_visited += u64::from(active.count_ones());
             }
             if is_leaf(cur) {
-                for b in leaf_slice(bvh, cur) {
-                    if COUNT {
-                        c.prim_tests += occupied(b) * u64::from(active.count_ones());
+                let blocks = leaf_slice(bvh, cur);
+                if COUNT {
+                    c.prim_tests += blocks.iter().map(occupied).sum::<u64>() * u64::from(active.count_ones());
+                }
+                if active.count_ones() <= FEW_IN_LEAF {
+                    few_in_leaf(blocks, prims, rays, &p, active, &mut best);
+                } else {
+                    for b in blocks {
+                        block(b, prims, rays, &p, (kx, ky, kz), active, &mut best);
                     }
-                    block(b, prims, rays, &p, (kx, ky, kz), active, &mut best);
                 }
                 far = _mm512_mul_ps(best.t, _mm512_set1_ps(ROBUST_FAR));
             } else {
@@ -165,6 +194,55 @@ pub(super) unsafe fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W
                 let mut entry = [const { MaybeUninit::<Lanes>::uninit() }; W];
                 let mut keys = [0u32; W];
                 let mut k = 0;
+                let mut sort = |key: u32, keys: &mut [u32; W]| {
+                    let mut j = k;
+                    while j > 0 && keys[j - 1] > key {
+                        keys[j] = keys[j - 1];
+                        j -= 1;
+                    }
+                    keys[j] = key;
+                    k += 1;
+                };
+                if active.count_ones() <= FEW_IN_NODE {
+                    // Each ray's 8-wide box test, scattered into the children's entries.
+                    let mut far_each = Lanes([0.0; PACKET]);
+                    // SAFETY: `Lanes` is 64-byte aligned.
+                    unsafe { _mm512_store_ps(far_each.0.as_mut_ptr(), far) };
+                    let mut least = [f32::INFINITY; W];
+                    let mut entered = 0u32;
+                    bvh.nodes[cur as usize].with_decoded(|node| {
+                        let mut m = active;
+                        while m != 0 {
+                            let r = m.trailing_zeros() as usize;
+                            m &= m - 1;
+                            // SAFETY: `W == 8` (the caller's check), so the types are the same.
+                            let node8 = unsafe { &*(node as *const WideNode<W>).cast::<WideNode<8>>() };
+                            // SAFETY: AVX2 is enabled here.
+                            let (t0, t1) = unsafe { slabs_avx2(node8, &p.boxes(r), far_each.0[r]) };
+                            let mut tn = [0.0f32; 8];
+                            // SAFETY: `tn` holds 8 f32.
+                            unsafe { _mm256_storeu_ps(tn.as_mut_ptr(), t0) };
+                            let mut hit = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32;
+                            while hit != 0 {
+                                let l = hit.trailing_zeros() as usize;
+                                hit &= hit - 1;
+                                if entered & (1 << l) == 0 {
+                                    entered |= 1 << l;
+                                    entry[l] = MaybeUninit::new(Lanes([f32::INFINITY; PACKET]));
+                                }
+                                // SAFETY: initialised just above when first entered.
+                                unsafe { entry[l].assume_init_mut() }.0[r] = tn[l];
+                                least[l] = least[l].min(tn[l]);
+                            }
+                        }
+                    });
+                    let mut m = entered;
+                    while m != 0 {
+                        let l = m.trailing_zeros();
+                        m &= m - 1;
+                        sort((least[l as usize].to_bits() & !lane_bits) | l, &mut keys);
+                    }
+                } else {
                 bvh.nodes[cur as usize].with_decoded(|node| {
                     #[allow(clippy::needless_range_loop)] // `l` indexes the child, its boxes and `entry`
                     for l in 0..W {
@@ -180,15 +258,10 @@ pub(super) unsafe fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W
                             _mm512_store_ps(entry[l].as_mut_ptr().cast(), _mm512_mask_blend_ps(hit, _mm512_set1_ps(f32::INFINITY), t0));
                             (_mm512_mask_reduce_min_ps(hit, t0).to_bits() & !lane_bits) | l as u32
                         };
-                        let mut j = k;
-                        while j > 0 && keys[j - 1] > key {
-                            keys[j] = keys[j - 1];
-                            j -= 1;
-                        }
-                        keys[j] = key;
-                        k += 1;
+                        sort(key, &mut keys);
                     }
                 });
+                }
                 if k > 0 {
                     let node = &bvh.nodes[cur as usize];
                     for &key in keys[1..k].iter().rev() {
@@ -229,6 +302,50 @@ pub(super) unsafe fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W
         }
     }
     true
+}
+
+/// Nodes that this many rays or fewer reach are tested ray by ray (each ray's 8-wide box
+/// test, as the child-major path does), and so are leaves with [`FEW_IN_LEAF`] (each
+/// ray's four-wide triangle test): sixteen lanes for a few rays cost more. (Embree's
+/// hybrid traversal switches to single rays for the same reason.)
+const FEW_IN_NODE: u32 = 6;
+const FEW_IN_LEAF: u32 = 4;
+
+/// The blocks of a leaf against the `active` rays one at a time, with the single-ray
+/// block test, from and into their best hits so far.
+#[inline]
+#[target_feature(enable = "avx2,avx512f,avx512vl,bmi1,bmi2")]
+fn few_in_leaf<P: Primitives + ?Sized>(blocks: &[TriBlock], prims: &P, rays: &[Ray], p: &Packet, active: __mmask16, best: &mut Best) {
+    let (mut t, mut u, mut v) = (Lanes([0.0; PACKET]), Lanes([0.0; PACKET]), Lanes([0.0; PACKET]));
+    let mut prim = [0u32; PACKET];
+    // SAFETY: `Lanes` is 64-byte aligned, and every array holds 16 lanes of 4 bytes.
+    unsafe {
+        _mm512_store_ps(t.0.as_mut_ptr(), best.t);
+        _mm512_store_ps(u.0.as_mut_ptr(), best.u);
+        _mm512_store_ps(v.0.as_mut_ptr(), best.v);
+        _mm512_storeu_si512(prim.as_mut_ptr().cast(), best.prim);
+    }
+    let mut m = active;
+    while m != 0 {
+        let r = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let mut hit = (prim[r] != u32::MAX).then(|| Hit { t: t.0[r], prim: prim[r], u: u.0[r], v: v.0[r] });
+        let mut ray = Ray { t_max: t.0[r], ..rays[r] };
+        let s = p.sheared(r);
+        for b in blocks {
+            block_closest::<P, true>(b, prims, &s, &mut ray, &mut hit);
+        }
+        if let Some(h) = hit {
+            (t.0[r], prim[r], u.0[r], v.0[r]) = (h.t, h.prim, h.u, h.v);
+        }
+    }
+    // SAFETY: as above.
+    unsafe {
+        best.t = _mm512_load_ps(t.0.as_ptr());
+        best.u = _mm512_load_ps(u.0.as_ptr());
+        best.v = _mm512_load_ps(v.0.as_ptr());
+        best.prim = _mm512_loadu_si512(prim.as_ptr().cast());
+    }
 }
 
 /// Child `l` of `node` against the `active` rays: the rays entering it (within each ray's

@@ -52,7 +52,7 @@ pub enum KernelArg {
     Portable,
     /// AVX2 for 8-wide nodes, SSE2 for 4-wide
     Simd,
-    /// The SIMD kernels compiled for AVX-512F/VL (32 vector registers)
+    /// The SIMD kernels compiled for AVX-512F/VL (32 vector registers); 8-wide packets ray-major, 16 rays per register
     Avx512,
 }
 
