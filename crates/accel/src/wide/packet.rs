@@ -18,7 +18,7 @@ use raylab_core::Ray;
 use super::kernels::slabs_avx2;
 use super::kernels::{RayBoxes, ROBUST_FAR};
 use super::node::{is_leaf, ChildRef, Layout, TriBlock, WideNode, EMPTY};
-use super::traverse::{block_closest, child_boxes, leaf_slice, occupied, STACK};
+use super::traverse::{block_closest, child_boxes, insert_sorted, leaf_slice, occupied, STACK};
 use super::WideBvh;
 use crate::{Counters, Hit, Primitives};
 
@@ -249,14 +249,7 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
                 let mut keys = [0u32; W];
                 let mut k = 0;
                 for l in bits(any) {
-                    let key = key(l);
-                    let mut j = k;
-                    while j > 0 && keys[j - 1] > key {
-                        keys[j] = keys[j - 1];
-                        j -= 1;
-                    }
-                    keys[j] = key;
-                    k += 1;
+                    insert_sorted(&mut keys, &mut k, key(l));
                 }
                 for &key in keys[1..k].iter().rev() {
                     let l = (key & lane_bits) as usize;

@@ -25,7 +25,7 @@ use raylab_core::{gamma, Ray};
 use super::kernels::{slabs_avx2, RayBoxes, ROBUST_FAR};
 use super::node::{is_leaf, Layout, TriBlock, WideNode, EMPTY};
 use super::packet::PACKET;
-use super::traverse::{block_closest, exact_lane, leaf_slice, occupied, STACK};
+use super::traverse::{block_closest, exact_lane, insert_sorted, leaf_slice, occupied, wins, STACK};
 use super::WideBvh;
 use crate::{Counters, Hit, Primitives};
 
@@ -136,6 +136,40 @@ struct Best {
     v: __m512,
 }
 
+/// [`Best`] stored lane by lane.
+struct BestLanes {
+    t: Lanes,
+    u: Lanes,
+    v: Lanes,
+    prim: [u32; PACKET],
+}
+
+impl Best {
+    #[target_feature(enable = "avx512f")]
+    fn store(&self) -> BestLanes {
+        let mut l = BestLanes { t: Lanes([0.0; PACKET]), u: Lanes([0.0; PACKET]), v: Lanes([0.0; PACKET]), prim: [0; PACKET] };
+        // SAFETY: `Lanes` is 64-byte aligned, and every array holds 16 lanes of 4 bytes.
+        unsafe {
+            _mm512_store_ps(l.t.0.as_mut_ptr(), self.t);
+            _mm512_store_ps(l.u.0.as_mut_ptr(), self.u);
+            _mm512_store_ps(l.v.0.as_mut_ptr(), self.v);
+            _mm512_storeu_si512(l.prim.as_mut_ptr().cast(), self.prim);
+        }
+        l
+    }
+
+    #[target_feature(enable = "avx512f")]
+    fn load(l: &BestLanes) -> Best {
+        // SAFETY: as in `store`.
+        unsafe { Best { t: _mm512_load_ps(l.t.0.as_ptr()), u: _mm512_load_ps(l.u.0.as_ptr()), v: _mm512_load_ps(l.v.0.as_ptr()), prim: _mm512_loadu_si512(l.prim.as_ptr().cast()) } }
+    }
+
+    /// Ray `r`'s hit so far.
+    fn hit(l: &BestLanes, r: usize) -> Option<Hit> {
+        (l.prim[r] != u32::MAX).then(|| Hit { t: l.t.0[r], prim: l.prim[r], u: l.u.0[r], v: l.v.0[r] })
+    }
+}
+
 /// Closest hits of `rays` (1 to [`PACKET`]) into `out` (as long as `rays`); `false`, with
 /// `out` and `c` untouched, for a packet whose rays do not share their box rows and shear
 /// axes. Counting (`COUNT`) charges as the child-major path does: each node once per
@@ -194,15 +228,6 @@ pub(super) unsafe fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W
                 let mut entry = [const { MaybeUninit::<Lanes>::uninit() }; W];
                 let mut keys = [0u32; W];
                 let mut k = 0;
-                let mut sort = |key: u32, keys: &mut [u32; W]| {
-                    let mut j = k;
-                    while j > 0 && keys[j - 1] > key {
-                        keys[j] = keys[j - 1];
-                        j -= 1;
-                    }
-                    keys[j] = key;
-                    k += 1;
-                };
                 if active.count_ones() <= FEW_IN_NODE {
                     // Each ray's 8-wide box test, scattered into the children's entries.
                     let mut far_each = Lanes([0.0; PACKET]);
@@ -240,7 +265,7 @@ pub(super) unsafe fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W
                     while m != 0 {
                         let l = m.trailing_zeros();
                         m &= m - 1;
-                        sort((least[l as usize].to_bits() & !lane_bits) | l, &mut keys);
+                        insert_sorted(&mut keys, &mut k, (least[l as usize].to_bits() & !lane_bits) | l);
                     }
                 } else {
                 bvh.nodes[cur as usize].with_decoded(|node| {
@@ -258,7 +283,7 @@ pub(super) unsafe fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W
                             _mm512_store_ps(entry[l].as_mut_ptr().cast(), _mm512_mask_blend_ps(hit, _mm512_set1_ps(f32::INFINITY), t0));
                             (_mm512_mask_reduce_min_ps(hit, t0).to_bits() & !lane_bits) | l as u32
                         };
-                        sort(key, &mut keys);
+                        insert_sorted(&mut keys, &mut k, key);
                     }
                 });
                 }
@@ -285,21 +310,9 @@ pub(super) unsafe fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W
         // SAFETY: entries below `sp` were written by the pushes above; `Lanes` is aligned.
         (cur, cur_t) = unsafe { (stack_node[sp].assume_init(), _mm512_load_ps(stack_t[sp].assume_init_ref().0.as_ptr())) };
     }
-    let mut t = Lanes([0.0; PACKET]);
-    let mut u = Lanes([0.0; PACKET]);
-    let mut v = Lanes([0.0; PACKET]);
-    let mut prim = [0u32; PACKET];
-    // SAFETY: `Lanes` is 64-byte aligned, and every array holds 16 lanes of 4 bytes.
-    unsafe {
-        _mm512_store_ps(t.0.as_mut_ptr(), best.t);
-        _mm512_store_ps(u.0.as_mut_ptr(), best.u);
-        _mm512_store_ps(v.0.as_mut_ptr(), best.v);
-        _mm512_storeu_si512(prim.as_mut_ptr().cast(), best.prim);
-    }
+    let lanes = best.store();
     for (r, o) in out.iter_mut().enumerate() {
-        if prim[r] != u32::MAX {
-            *o = Some(Hit { t: t.0[r], prim: prim[r], u: u.0[r], v: v.0[r] });
-        }
+        *o = Best::hit(&lanes, r);
     }
     true
 }
@@ -316,36 +329,22 @@ const FEW_IN_LEAF: u32 = 4;
 #[inline]
 #[target_feature(enable = "avx2,avx512f,avx512vl,bmi1,bmi2")]
 fn few_in_leaf<P: Primitives + ?Sized>(blocks: &[TriBlock], prims: &P, rays: &[Ray], p: &Packet, active: __mmask16, best: &mut Best) {
-    let (mut t, mut u, mut v) = (Lanes([0.0; PACKET]), Lanes([0.0; PACKET]), Lanes([0.0; PACKET]));
-    let mut prim = [0u32; PACKET];
-    // SAFETY: `Lanes` is 64-byte aligned, and every array holds 16 lanes of 4 bytes.
-    unsafe {
-        _mm512_store_ps(t.0.as_mut_ptr(), best.t);
-        _mm512_store_ps(u.0.as_mut_ptr(), best.u);
-        _mm512_store_ps(v.0.as_mut_ptr(), best.v);
-        _mm512_storeu_si512(prim.as_mut_ptr().cast(), best.prim);
-    }
+    let mut lanes = best.store();
     let mut m = active;
     while m != 0 {
         let r = m.trailing_zeros() as usize;
         m &= m - 1;
-        let mut hit = (prim[r] != u32::MAX).then(|| Hit { t: t.0[r], prim: prim[r], u: u.0[r], v: v.0[r] });
-        let mut ray = Ray { t_max: t.0[r], ..rays[r] };
+        let mut hit = Best::hit(&lanes, r);
+        let mut ray = Ray { t_max: lanes.t.0[r], ..rays[r] };
         let s = p.sheared(r);
         for b in blocks {
             block_closest::<P, true>(b, prims, &s, &mut ray, &mut hit);
         }
         if let Some(h) = hit {
-            (t.0[r], prim[r], u.0[r], v.0[r]) = (h.t, h.prim, h.u, h.v);
+            (lanes.t.0[r], lanes.prim[r], lanes.u.0[r], lanes.v.0[r]) = (h.t, h.prim, h.u, h.v);
         }
     }
-    // SAFETY: as above.
-    unsafe {
-        best.t = _mm512_load_ps(t.0.as_ptr());
-        best.u = _mm512_load_ps(u.0.as_ptr());
-        best.v = _mm512_load_ps(v.0.as_ptr());
-        best.prim = _mm512_loadu_si512(prim.as_ptr().cast());
-    }
+    *best = Best::load(&lanes);
 }
 
 /// Child `l` of `node` against the `active` rays: the rays entering it (within each ray's
@@ -388,17 +387,11 @@ fn block<P: Primitives + ?Sized>(b: &TriBlock, prims: &P, rays: &[Ray], p: &Pack
         while m != 0 {
             let r = m.trailing_zeros() as usize;
             m &= m - 1;
-            let mut t_max = Lanes([0.0; PACKET]);
-            let mut best_prim = [0u32; PACKET];
-            // SAFETY: `Lanes` is 64-byte aligned; both arrays hold 16 lanes of 4 bytes.
-            unsafe {
-                _mm512_store_ps(t_max.0.as_mut_ptr(), best.t);
-                _mm512_storeu_si512(best_prim.as_mut_ptr().cast(), best.prim);
-            }
-            let ray = Ray { t_max: t_max.0[r], ..rays[r] };
+            let so_far = best.store();
+            let ray = Ray { t_max: so_far.t.0[r], ..rays[r] };
             let id = prim & !TriBlock::OTHER;
-            let first = best_prim[r] == u32::MAX;
-            if let Some(x) = exact_lane(b, j, prims, &ShearedRay::new(&ray), &ray).filter(|x| x.t <= ray.t_max && (first || x.t < ray.t_max || id < best_prim[r])) {
+            let so_far = Best::hit(&so_far, r);
+            if let Some(x) = exact_lane(b, j, prims, &ShearedRay::new(&ray), &ray).filter(|x| x.t <= ray.t_max && wins(x.t, id, &so_far)) {
                 keep(best, 1 << r, _mm512_set1_ps(x.t), _mm512_set1_ps(x.u), _mm512_set1_ps(x.v), id);
             }
         }

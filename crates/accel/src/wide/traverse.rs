@@ -137,6 +137,19 @@ pub(super) fn exact_lane<P: Primitives + ?Sized>(b: &TriBlock, l: usize, prims: 
     }
 }
 
+/// Inserts `key` into the ascending `keys[..*n]` and counts it: an insertion sort of a
+/// node's entered children (at most `W` keys of entry distance bits and lane).
+#[inline(always)]
+pub(super) fn insert_sorted<const W: usize>(keys: &mut [u32; W], n: &mut usize, key: u32) {
+    let mut k = *n;
+    while k > 0 && keys[k - 1] > key {
+        keys[k] = keys[k - 1];
+        k -= 1;
+    }
+    keys[k] = key;
+    *n += 1;
+}
+
 /// Occupied lanes of a block (what the counting build charges as primitive tests).
 #[inline(always)]
 pub(super) fn occupied(b: &TriBlock) -> u64 {
@@ -229,14 +242,7 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
                 while m != 0 {
                     let l = m.trailing_zeros();
                     m &= m - 1;
-                    let key = (tnear[l as usize].to_bits() & !lane_bits) | l;
-                    let mut k = n;
-                    while k > 0 && keys[k - 1] > key {
-                        keys[k] = keys[k - 1];
-                        k -= 1;
-                    }
-                    keys[k] = key;
-                    n += 1;
+                    insert_sorted(&mut keys, &mut n, (tnear[l as usize].to_bits() & !lane_bits) | l);
                 }
                 for &key in keys[1..n].iter().rev() {
                     let l = (key & lane_bits) as usize;
