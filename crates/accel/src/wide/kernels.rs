@@ -265,7 +265,7 @@ pub fn triangles_sse(b: &TriBlock, s: &ShearedRay, t_min: f32, t_max: f32) -> Bl
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::wide::node::WideNode;
     use raylab_core::{Aabb, Vec3};
@@ -348,6 +348,25 @@ mod tests {
         assert!(kept > 100, "too few hits to test the filter: {kept}");
     }
 
+    /// A block of `lanes` triangles for kernel tests, from `r(scale)` (random points at that
+    /// scale): by `k`, some lanes are all zero and some have two equal vertices (the
+    /// scalar kernel's zero edge functions), the rest random.
+    pub(in crate::wide) fn random_block(k: usize, lanes: usize, scale: f32, r: &mut impl FnMut(f32) -> Vec3) -> TriBlock {
+        let mut b = TriBlock::EMPTY_BLOCK;
+        for l in 0..lanes {
+            let v = match (k + l) % 6 {
+                0 => [Vec3::ZERO; 3],
+                1 => {
+                    let p = r(scale);
+                    [p, p, r(scale)]
+                }
+                _ => [r(scale), r(scale), r(scale)],
+            };
+            b.set_triangle(l, l as u32, v);
+        }
+        b
+    }
+
     /// The four-wide kernel decides each lane exactly as the scalar kernel does (same `t`
     /// and barycentrics to the bit) or hands it to the scalar kernel: on random triangles,
     /// degenerate ones (zero area, a vertex at the origin: zero edge functions), tiny,
@@ -361,19 +380,8 @@ mod tests {
         let (mut hits, mut exact) = (0, 0);
         for k in 0..40000 {
             let scale = [1.0, 1e-30, 1e30, 3e38, 1e6][(k / 4) % 5];
-            let mut b = TriBlock::EMPTY_BLOCK;
             let lanes = k % 4 + 1;
-            for l in 0..lanes {
-                let v = match (k + l) % 6 {
-                    0 => [Vec3::ZERO; 3],
-                    1 => {
-                        let p = r(scale);
-                        [p, p, r(scale)]
-                    }
-                    _ => [r(scale), r(scale), r(scale)],
-                };
-                b.set_triangle(l, l as u32, v);
-            }
+            let mut b = random_block(k, lanes, scale, &mut r);
             if k % 7 == 0 {
                 b.prim[0] = 3 | TriBlock::OTHER;
             }

@@ -618,7 +618,6 @@ mod tests {
     #[test]
     fn the_triangle_kernel_matches_the_four_wide_kernel_ray_by_ray() {
         use super::super::kernels::triangles_sse;
-        use super::super::node::TriBlock;
         use raylab_core::intersect::ShearedRay;
         use std::arch::x86_64::*;
         use std::is_x86_feature_detected as has;
@@ -630,18 +629,7 @@ mod tests {
         let (mut hits, mut exact, mut packets) = (0, 0, 0);
         for k in 0..6000 {
             let scale = [1.0, 1e-30, 1e30, 3e38, 1e6][k % 5];
-            let mut b = TriBlock::EMPTY_BLOCK;
-            for l in 0..4 {
-                let v = match (k + l) % 6 {
-                    0 => [Vec3::ZERO; 3],
-                    1 => {
-                        let p = r(scale);
-                        [p, p, r(scale)]
-                    }
-                    _ => [r(scale), r(scale), r(scale)],
-                };
-                b.set_triangle(l, l as u32, v);
-            }
+            let b = super::super::kernels::tests::random_block(k, 4, scale, &mut r);
             let origin = match k % 3 {
                 0 => r(2.0 * scale),
                 1 => Vec3::ZERO,
