@@ -163,7 +163,7 @@ struct Far([f32; PACKET]);
 
 /// Starts loading a pushed child: the packet works on its nearer siblings first.
 #[inline(always)]
-fn prefetch<const W: usize, N: Layout<W>>(bvh: &WideBvh<W, N>, r: ChildRef) {
+pub(super) fn prefetch<const W: usize, N: Layout<W>>(bvh: &WideBvh<W, N>, r: ChildRef) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
