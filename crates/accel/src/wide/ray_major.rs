@@ -27,7 +27,7 @@ use std::mem::MaybeUninit;
 use raylab_core::intersect::ShearedRay;
 use raylab_core::{gamma, Ray};
 
-use super::kernels::{slabs_avx2, RayBoxes, ROBUST_FAR};
+use super::kernels::ROBUST_FAR;
 use super::node::{is_leaf, Layout, TriBlock, WideNode, EMPTY};
 use super::packet::{prefetch, PACKET};
 use super::traverse::{block_closest, exact_lane, insert_sorted, leaf_slice, occupied, wins, STACK};
@@ -52,8 +52,8 @@ struct Packet {
     far_rows: [usize; 3],
     /// `(kx, ky, kz)` of every ray's `ShearedRay`.
     axes: (usize, usize, usize),
-    /// `origin`, `inv`, `inv_far`, `shear` and `t_min` stored lane by lane (13 rows).
-    each: [Lanes; 13],
+    /// `origin` and `shear` stored lane by lane (6 rows).
+    each: [Lanes; 6],
     /// The packet's frustum, when its constants are finite.
     frustum: Option<Frustum>,
 }
@@ -77,17 +77,11 @@ struct Frustum {
 }
 
 impl Packet {
-    /// Ray `r`'s `RayBoxes`.
-    fn boxes(&self, r: usize) -> RayBoxes {
-        let e = |k: usize| self.each[k].0[r];
-        RayBoxes { origin: [e(0), e(1), e(2)], inv: [e(3), e(4), e(5)], inv_far: [e(6), e(7), e(8)], near: self.near_rows, far: self.far_rows, t_min: e(12) }
-    }
-
     /// Ray `r`'s `ShearedRay`.
     fn sheared(&self, r: usize) -> ShearedRay {
         let e = |k: usize| self.each[k].0[r];
         let (kx, ky, kz) = self.axes;
-        ShearedRay { origin: raylab_core::Vec3::new(e(0), e(1), e(2)), kx, ky, kz, sx: e(9), sy: e(10), sz: e(11) }
+        ShearedRay { origin: raylab_core::Vec3::new(e(0), e(1), e(2)), kx, ky, kz, sx: e(3), sy: e(4), sz: e(5) }
     }
 }
 
@@ -139,9 +133,9 @@ impl Packet {
         let robust_far = _mm512_set1_ps(ROBUST_FAR);
         let shear = [_mm512_div_ps(dir[kx], dir[kz]), _mm512_div_ps(dir[ky], dir[kz]), _mm512_div_ps(one, dir[kz])];
         let inv_far = inv.map(|i| _mm512_mul_ps(i, robust_far));
-        // The same constants ray by ray, for nodes and leaves that few rays reach.
-        let mut each = [Lanes([0.0; PACKET]); 13];
-        for (k, x) in origin.iter().chain(&inv).chain(&inv_far).chain(&shear).chain([&t_min]).enumerate() {
+        // The same constants ray by ray, for leaves that one ray reaches.
+        let mut each = [Lanes([0.0; PACKET]); 6];
+        for (k, x) in origin.iter().chain(&shear).enumerate() {
             // SAFETY: `Lanes` is 64-byte aligned.
             unsafe { _mm512_store_ps(each[k].0.as_mut_ptr(), *x) };
         }
@@ -260,53 +254,12 @@ pub(super) unsafe fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W
                 far = _mm512_mul_ps(best.t, _mm512_set1_ps(ROBUST_FAR));
                 far_max = _mm512_reduce_max_ps(far);
             } else {
-                // Children any ray entered, nearest first by their rays' least entry
-                // distance (the child-major path's order, so a packet of copies walks as
-                // one ray does); the others wait on the stack with each ray's distance.
+                // Children any ray entered, the nearest first; the others wait on the
+                // stack with each ray's entry distance.
                 let lane_bits = W as u32 - 1;
                 let mut entry = [const { MaybeUninit::<Lanes>::uninit() }; W];
                 let mut keys = [0u32; W];
                 let mut k = 0;
-                if active.count_ones() <= FEW_IN_NODE {
-                    // Each ray's 8-wide box test, scattered into the children's entries.
-                    let mut far_each = Lanes([0.0; PACKET]);
-                    // SAFETY: `Lanes` is 64-byte aligned.
-                    unsafe { _mm512_store_ps(far_each.0.as_mut_ptr(), far) };
-                    let mut least = [f32::INFINITY; W];
-                    let mut entered = 0u32;
-                    bvh.nodes[cur as usize].with_decoded(|node| {
-                        let mut m = active;
-                        while m != 0 {
-                            let r = m.trailing_zeros() as usize;
-                            m &= m - 1;
-                            // SAFETY: `W == 8` (the caller's check), so the types are the same.
-                            let node8 = unsafe { &*(node as *const WideNode<W>).cast::<WideNode<8>>() };
-                            // SAFETY: AVX2 is enabled here.
-                            let (t0, t1) = unsafe { slabs_avx2(node8, &p.boxes(r), far_each.0[r]) };
-                            let mut tn = [0.0f32; 8];
-                            // SAFETY: `tn` holds 8 f32.
-                            unsafe { _mm256_storeu_ps(tn.as_mut_ptr(), t0) };
-                            let mut hit = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32;
-                            while hit != 0 {
-                                let l = hit.trailing_zeros() as usize;
-                                hit &= hit - 1;
-                                if entered & (1 << l) == 0 {
-                                    entered |= 1 << l;
-                                    entry[l] = MaybeUninit::new(Lanes([f32::INFINITY; PACKET]));
-                                }
-                                // SAFETY: initialised just above when first entered.
-                                unsafe { entry[l].assume_init_mut() }.0[r] = tn[l];
-                                least[l] = least[l].min(tn[l]);
-                            }
-                        }
-                    });
-                    let mut m = entered;
-                    while m != 0 {
-                        let l = m.trailing_zeros();
-                        m &= m - 1;
-                        insert_sorted(&mut keys, &mut k, (least[l as usize].to_bits() & !lane_bits) | l);
-                    }
-                } else {
                 bvh.nodes[cur as usize].with_decoded(|node| {
                     // SAFETY: `W == 8` (the caller's check), so the types are the same.
                     let node8 = unsafe { &*(node as *const WideNode<W>).cast::<WideNode<8>>() };
@@ -342,7 +295,6 @@ pub(super) unsafe fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W
                         insert_sorted(&mut keys, &mut k, key);
                     }
                 });
-                }
                 if k > 0 {
                     let node = &bvh.nodes[cur as usize];
                     for &key in keys[1..k].iter().rev() {
@@ -374,12 +326,10 @@ pub(super) unsafe fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W
     true
 }
 
-/// Nodes that this many rays or fewer reach are tested ray by ray (each ray's 8-wide box
-/// test, as the child-major path does), and so are leaves with [`FEW_IN_LEAF`] (each
-/// ray's four-wide triangle test): sixteen lanes for a few rays cost more. (Embree's
-/// hybrid traversal switches to single rays for the same reason.)
-const FEW_IN_NODE: u32 = 6;
-const FEW_IN_LEAF: u32 = 4;
+/// Leaves that this many rays or fewer reach are tested ray by ray (each ray's four-wide
+/// triangle test): sixteen lanes for one ray cost more. Nodes are always tested in sixteen
+/// lanes: after the frustum test that is cheaper than ray by ray even for two rays.
+const FEW_IN_LEAF: u32 = 1;
 
 /// The blocks of a leaf against the `active` rays one at a time, with the single-ray
 /// block test, from and into their best hits so far.
@@ -760,7 +710,7 @@ mod tests {
     /// among them) against packets spread over a wide cone, some from scattered origins.
     #[test]
     fn the_frustum_keeps_every_child_a_ray_enters() {
-        use super::super::kernels::slabs_avx2;
+        use super::super::kernels::{slabs_avx2, RayBoxes};
         use std::arch::x86_64::*;
         use std::is_x86_feature_detected as has;
         if !(has!("avx512f") && has!("avx512vl") && has!("avx2")) {
@@ -805,7 +755,7 @@ mod tests {
             let mut any = 0u32;
             for (q, &far_q) in far_each.iter().enumerate() {
                 // SAFETY: as above.
-                let (n, x) = unsafe { slabs_avx2(&node, &p.boxes(q), far_q) };
+                let (n, x) = unsafe { slabs_avx2(&node, &RayBoxes::new(&rays[q]), far_q) };
                 let (mut near, mut exit) = ([0.0f32; 8], [0.0f32; 8]);
                 // SAFETY: as above.
                 unsafe { (_mm256_storeu_ps(near.as_mut_ptr(), n), _mm256_storeu_ps(exit.as_mut_ptr(), x)) };
