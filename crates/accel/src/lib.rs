@@ -411,6 +411,16 @@ impl AnyAccel {
         }
     }
 
+    /// The packet kernel of a wide BVH; `None` for other structures.
+    pub fn packet_kernel(&self) -> Option<Kernel> {
+        match self {
+            AnyAccel::Bvh8(a) => Some(a.packet_kernel()),
+            AnyAccel::Bvh4(a) => Some(a.packet_kernel()),
+            AnyAccel::Bvh8Q(a) => Some(a.packet_kernel()),
+            _ => None,
+        }
+    }
+
     /// Forces the kernel of a wide BVH (no effect on other structures): tests compare the
     /// SIMD and portable kernels.
     pub fn with_kernel(self, k: Kernel) -> Self {

@@ -681,8 +681,9 @@ fn empty_wide_bvh_counts_the_ray_only() {
     }
 }
 
-/// The kernel is chosen at run time: `Simd` by default where the CPU runs it, `Avx512` only
-/// when asked for, `Portable` always available.
+/// The kernel is chosen at run time: `Simd` by default where the CPU runs it, `Avx512` for
+/// the packets of 8-wide nodes where the CPU runs it and otherwise only when asked for,
+/// `Portable` always available; a forced kernel is that of packets too.
 #[test]
 fn kernels_are_chosen_by_what_the_cpu_runs() {
     let soup = raylab_testkit::cube();
@@ -691,7 +692,10 @@ fn kernels_are_chosen_by_what_the_cpu_runs() {
         let accel = AnyAccel::build(kind, &soup, &BuildOptions::default());
         let simd = ks.contains(&Kernel::Simd);
         assert_eq!(accel.kernel(), Some(if simd { Kernel::Simd } else { Kernel::Portable }), "{kind}");
-        assert_eq!(accel.with_kernel(Kernel::Portable).kernel(), Some(Kernel::Portable));
+        let ray_major = w == 8 && ks.contains(&Kernel::Avx512);
+        assert_eq!(accel.packet_kernel(), if ray_major { Some(Kernel::Avx512) } else { accel.kernel() }, "{kind}");
+        let portable = accel.with_kernel(Kernel::Portable);
+        assert_eq!((portable.kernel(), portable.packet_kernel()), (Some(Kernel::Portable), Some(Kernel::Portable)));
         let accel = AnyAccel::build(kind, &soup, &BuildOptions::default()).with_kernel(Kernel::Avx512);
         let best = *ks.last().unwrap();
         assert_eq!(accel.kernel(), Some(best), "{kind}: Avx512 where it runs, else the next best");

@@ -41,17 +41,24 @@ pub enum Kernel {
     /// registers instead of 16 and mask registers for the compares. Same IEEE operations
     /// in the same order, so the same answers. Packets of 8-wide nodes whose rays share box
     /// rows and shear axes go ray-major, sixteen rays in the lanes of a 512-bit register
-    /// (`wide/ray_major.rs`). Opt-in: see [`Kernel::detect`].
+    /// (`wide/ray_major.rs`). The default for such packets where the CPU runs it: see
+    /// [`Kernel::detect_packets`].
     Avx512,
 }
 
 impl Kernel {
-    /// The default kernel for width `w` on this CPU (runtime detection: the binary stays
-    /// portable, no `target-cpu` needed): [`Kernel::Simd`] where it runs. Not
-    /// [`Kernel::Avx512`]: measured no faster (docs/performance.md), it is there to be
-    /// chosen (`raylab trace --kernel avx512`) and compared.
+    /// The default kernel of single rays for width `w` on this CPU (runtime detection: the
+    /// binary stays portable, no `target-cpu` needed): [`Kernel::Simd`] where it runs. Not
+    /// [`Kernel::Avx512`]: for single rays it measured no faster (docs/performance.md).
     pub fn detect(w: usize) -> Kernel {
         Kernel::Simd.available(w)
+    }
+
+    /// The default kernel of packets: [`Kernel::Avx512`] for 8-wide nodes where the CPU
+    /// runs it (ray-major packets, faster than the child-major ones of [`Kernel::Simd`]:
+    /// docs/performance.md, eleventh round), else that of single rays.
+    pub fn detect_packets(w: usize) -> Kernel {
+        if w == 8 { Kernel::Avx512.available(w) } else { Kernel::detect(w) }
     }
 
     /// `self` if this CPU runs it for width `w`, else the next best that it runs.
@@ -86,7 +93,9 @@ pub struct WideBvh<const W: usize, N: Layout<W> = WideNode<W>> {
     pub(crate) build_ms: f64,
     primitives: usize,
     spatial_splits: bool,
+    /// The kernels of single rays and of packets.
     kernel: Kernel,
+    packet_kernel: Kernel,
 }
 
 impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
@@ -97,18 +106,23 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
         let nodes: Vec<N> = encode(&c.nodes, c.root);
         // The root's decoded boxes may round past the scene's bounds: the root box holds them.
         let root_bounds = if c.root == EMPTY || is_leaf(c.root) { c.root_bounds } else { nodes[c.root as usize].with_decoded(|n| (0..W).filter(|&l| n.child[l] != EMPTY).fold(c.root_bounds, |b, l| b.union(n.child_bounds(l)))) };
-        Self { nodes, blocks: c.blocks, root: c.root, root_bounds, name, build_ms: 0.0, primitives: prims.len(), spatial_splits: bvh.spatial_splits, kernel: Kernel::detect(W) }
+        Self { nodes, blocks: c.blocks, root: c.root, root_bounds, name, build_ms: 0.0, primitives: prims.len(), spatial_splits: bvh.spatial_splits, kernel: Kernel::detect(W), packet_kernel: Kernel::detect_packets(W) }
     }
 
-    /// Forces a kernel (tests compare them). Asking for one this CPU lacks gives the next
-    /// best it has ([`Kernel::available`]).
+    /// Forces a kernel, for single rays and packets (tests compare them). Asking for one
+    /// this CPU lacks gives the next best it has ([`Kernel::available`]).
     pub fn with_kernel(mut self, k: Kernel) -> Self {
         self.kernel = k.available(W);
+        self.packet_kernel = self.kernel;
         self
     }
 
     pub fn kernel(&self) -> Kernel {
         self.kernel
+    }
+
+    pub fn packet_kernel(&self) -> Kernel {
+        self.packet_kernel
     }
 
     pub fn root_bounds(&self) -> Aabb {
@@ -144,7 +158,7 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
     #[inline]
     fn packet_dispatch<P: Primitives + ?Sized, const COUNT: bool>(&self, prims: &P, rays: &[Ray], out: &mut [Option<Hit>], c: &mut Counters) {
         #[cfg(target_arch = "x86_64")]
-        if W == 8 && self.kernel == Kernel::Avx512 && !rays.is_empty() && rays.len() <= PACKET && out.len() == rays.len() && ray_major_available() {
+        if W == 8 && self.packet_kernel == Kernel::Avx512 && !rays.is_empty() && rays.len() <= PACKET && out.len() == rays.len() && ray_major_available() {
             // SAFETY: the features were detected (`Kernel::Avx512` is only chosen after
             // detecting them, and `ray_major_available` checks them again).
             if unsafe { ray_major::closest::<P, W, N, COUNT>(self, prims, rays, out, c) } {
@@ -152,7 +166,7 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
             }
         }
         #[cfg(target_arch = "x86_64")]
-        match self.kernel {
+        match self.packet_kernel {
             // SAFETY: `Kernel::Avx512` is only chosen after detecting its features.
             Kernel::Avx512 => return unsafe { packet_avx512::<P, W, N, COUNT>(self, prims, rays, out, c) },
             // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
@@ -341,6 +355,7 @@ impl<const W: usize, N: Layout<W>> Accel for WideBvh<W, N> {
         s.note("width", W);
         s.note("boxes", N::NAME);
         s.note("kernel", format!("{:?}", self.kernel));
+        s.note("packet kernel", format!("{:?}", self.packet_kernel));
         s.note("block fill", format!("{:.0}%", 100.0 * blocks_used as f64 / (4 * self.blocks.len()).max(1) as f64));
         s.note("bytes/triangle", format!("{:.1}", s.memory_bytes as f64 / self.primitives.max(1) as f64));
         s

@@ -37,8 +37,9 @@ pub struct TraceArgs {
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=raylab_accel::PACKET as i64))]
     pub packet: Option<u32>,
     /// Kernels of the wide BVHs (bvh4, bvh8, bvh8-sbvh, bvh8q): the default (simd where the CPU
-    /// runs it), or one forced to compare them (a kernel the CPU lacks falls back to the
-    /// next best; all give the same answers)
+    /// runs it; avx512 for packets of 8-wide nodes where the CPU runs that), or one forced to
+    /// compare them (a kernel the CPU lacks falls back to the next best; all give the same
+    /// answers)
     #[arg(long, default_value = "auto", value_enum)]
     pub kernel: KernelArg,
     /// Print JSON
@@ -76,7 +77,8 @@ pub fn run(a: &TraceArgs) -> Result<()> {
             KernelArg::Simd => accel.with_kernel(Kernel::Simd),
             KernelArg::Avx512 => accel.with_kernel(Kernel::Avx512),
         };
-        let kernel = accel.kernel().map_or("-".to_string(), |k| format!("{k:?}").to_lowercase());
+        let kernel = if a.packet.is_some() { accel.packet_kernel() } else { accel.kernel() };
+        let kernel = kernel.map_or("-".to_string(), |k| format!("{k:?}").to_lowercase());
         let build_ms = accel.stats().build_ms;
         let mut results = Vec::new();
         for _ in 0..=a.repeats {
