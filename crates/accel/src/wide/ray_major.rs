@@ -144,12 +144,16 @@ impl Packet {
         let inf = _mm512_set1_ps(f32::INFINITY);
         let finite = |x: &__m512| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(_mm512_abs_ps(*x), inf) == 0xFFFF;
         let frustum = (origin.iter().chain(&inv).chain(&inv_far).all(finite) && finite(&t_min)).then(|| {
-            let along = |a: usize, pos: f32, neg: f32| if negative[a] == 0 { pos } else { neg };
+            let (lo, hi) = (origin.map(min), origin.map(max));
+            let along = |a: usize, pos: [f32; 3], neg: [f32; 3]| if negative[a] == 0 { pos[a] } else { neg[a] };
+            let inv = inv.map(|i| [min(i), max(i)]);
             Frustum {
-                near_origin: [0, 1, 2].map(|a| along(a, max(origin[a]), min(origin[a]))),
-                far_origin: [0, 1, 2].map(|a| along(a, min(origin[a]), max(origin[a]))),
-                inv: inv.map(|i| [min(i), max(i)]),
-                inv_far: inv_far.map(|i| [min(i), max(i)]),
+                near_origin: [0, 1, 2].map(|a| along(a, hi, lo)),
+                far_origin: [0, 1, 2].map(|a| along(a, lo, hi)),
+                inv,
+                // Rounding is monotone: the extremes of `inv · ROBUST_FAR` are those of `inv`
+                // times it, as each lane computes it.
+                inv_far: inv.map(|[l, h]| [l * ROBUST_FAR, h * ROBUST_FAR]),
                 t_min: min(t_min),
             }
         });
