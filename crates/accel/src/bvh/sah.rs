@@ -23,12 +23,17 @@ impl SahCost {
 
     /// Cost of splitting `parent` into `(left, n_left)` and `(right, n_right)`.
     pub fn split(&self, parent: &Aabb, left: &Aabb, n_left: usize, right: &Aabb, n_right: usize) -> f32 {
-        let pa = parent.half_area();
-        if pa <= 0.0 {
+        self.split_areas(parent.half_area(), left.half_area(), n_left, right.half_area(), n_right)
+    }
+
+    /// [`SahCost::split`] from the boxes' half areas (a sweep keeps areas, not boxes).
+    #[inline]
+    pub fn split_areas(&self, parent: f32, left: f32, n_left: usize, right: f32, n_right: usize) -> f32 {
+        if parent <= 0.0 {
             // A flat or point-like parent: every ray that hits it hits both children.
             return self.traversal + self.intersection * (n_left + n_right) as f32;
         }
-        self.traversal + self.intersection * (left.half_area() * n_left as f32 + right.half_area() * n_right as f32) / pa
+        self.traversal + self.intersection * (left * n_left as f32 + right * n_right as f32) / parent
     }
 }
 

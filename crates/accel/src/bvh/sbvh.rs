@@ -33,8 +33,8 @@ struct Ref {
 }
 
 enum Split {
-    /// Refs whose centroid falls in a bin below `plane` go left.
-    Object { axis: usize, plane: usize, lo: f32, scale: f32 },
+    /// Refs whose centroid falls in a bin (of `bins`) below `plane` go left.
+    Object { axis: usize, plane: usize, lo: f32, scale: f32, bins: usize },
     /// A plane at `pos`; `left`, `right`, `n_left`, `n_right` are the children estimated by
     /// the bins, used to decide unsplitting.
     Spatial { axis: usize, pos: f32, left: Aabb, right: Aabb, n_left: usize, n_right: usize },
@@ -69,7 +69,8 @@ pub fn build<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions) -> Bvh {
     };
     if n > 0 {
         b.nodes.push(BvhNode::interior(Aabb::EMPTY, 0));
-        b.node(0, refs, 1, (SPLIT_BUDGET * n as f32) as usize);
+        let mut scratch = Scratch::new(b.bins);
+        b.node(0, refs, 1, (SPLIT_BUDGET * n as f32) as usize, &mut scratch);
     }
     Bvh::from_parts(b.nodes, b.indices, n, "sbvh").with_spatial_splits()
 }
@@ -77,25 +78,28 @@ pub fn build<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions) -> Bvh {
 impl<P: Primitives + ?Sized> Builder<'_, P> {
     /// Builds the subtree over `refs` into `nodes[slot]`, allowing `budget` more duplicate
     /// references below; returns the box written.
-    fn node(&mut self, slot: usize, mut refs: Vec<Ref>, depth: usize, budget: usize) -> Aabb {
-        let bounds = refs.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds));
+    fn node(&mut self, slot: usize, refs: Vec<Ref>, depth: usize, budget: usize, scratch: &mut Scratch) -> Aabb {
+        let (bounds, centroids) = refs.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), r| (b.union(r.bounds), c.grow(r.bounds.centroid())));
         let n = refs.len();
-        let split = if n <= 1 || depth >= MAX_DEPTH { None } else { self.split(&refs, &bounds, budget) };
-        let children = match split.and_then(|s| self.apply(&refs, s, budget)) {
-            Some(c) => Some(c),
+        let split = if n <= 1 || depth >= MAX_DEPTH { None } else { self.split(&refs, &bounds, &centroids, budget, scratch) };
+        let children = match split {
+            Some(s) => self.apply(refs, s, budget),
+            None => Err(refs),
+        };
+        let (left, right) = match children {
+            Ok(c) => c,
             // No plane separates the references (all centroids coincide, or a spatial split
             // left one side empty): halve by index while the leaf would be too large.
-            None if n > self.max_leaf && depth < MAX_DEPTH => {
+            Err(mut refs) if n > self.max_leaf && depth < MAX_DEPTH => {
                 let right = refs.split_off(n / 2);
-                Some((std::mem::take(&mut refs), right))
+                (refs, right)
             }
-            None => None,
-        };
-        let Some((left, right)) = children else {
-            let leaf = Aabb { min: bounds.min - self.margin, max: bounds.max + self.margin };
-            self.nodes[slot] = BvhNode::leaf(leaf, self.indices.len() as u32, n as u32);
-            self.indices.extend(refs.iter().map(|r| r.prim));
-            return leaf;
+            Err(refs) => {
+                let leaf = Aabb { min: bounds.min - self.margin, max: bounds.max + self.margin };
+                self.nodes[slot] = BvhNode::leaf(leaf, self.indices.len() as u32, n as u32);
+                self.indices.extend(refs.iter().map(|r| r.prim));
+                return leaf;
+            }
         };
         let dups = (left.len() + right.len()).saturating_sub(n);
         let rest = budget.saturating_sub(dups);
@@ -108,11 +112,11 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
             // The right subtree goes to a builder of its own on another thread, then is
             // appended after the left one: the layout of the serial build, on any thread count.
             let mut sub = self.fork();
-            let (bl, br) = rayon::join(|| self.node(l, left, depth + 1, left_budget), || sub.node(0, right, depth + 1, right_budget));
+            let (bl, br) = rayon::join(|| self.node(l, left, depth + 1, left_budget, scratch), || sub.node(0, right, depth + 1, right_budget, &mut Scratch::new(sub.bins)));
             self.append(l + 1, sub);
             (bl, br)
         } else {
-            (self.node(l, left, depth + 1, left_budget), self.node(l + 1, right, depth + 1, right_budget))
+            (self.node(l, left, depth + 1, left_budget, scratch), self.node(l + 1, right, depth + 1, right_budget, scratch))
         };
         let b = bl.union(br);
         self.nodes[slot] = BvhNode::interior(b, l as u32);
@@ -139,11 +143,11 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
     }
 
     /// The cheaper of the best object and spatial splits, or `None` when a leaf is cheaper
-    /// and allowed.
-    fn split(&self, refs: &[Ref], bounds: &Aabb, budget: usize) -> Option<Split> {
-        let object = self.object_split(refs, bounds);
+    /// and allowed. `centroids` bounds the references' centroids.
+    fn split(&self, refs: &[Ref], bounds: &Aabb, centroids: &Aabb, budget: usize, scratch: &mut Scratch) -> Option<Split> {
+        let object = self.object_split(refs, bounds, centroids, scratch);
         let overlap = object.as_ref().map_or(f32::INFINITY, |(_, _, l, r)| l.intersection(*r).half_area());
-        let spatial = (budget > 0 && overlap > self.min_overlap).then(|| self.spatial_split(refs, bounds)).flatten();
+        let spatial = (budget > 0 && overlap > self.min_overlap).then(|| self.spatial_split(refs, bounds, scratch)).flatten();
         let best = match (object, spatial) {
             (Some((co, o, _, _)), Some((cs, s))) => Some(if cs < co { (cs, s) } else { (co, o) }),
             (Some((co, o, _, _)), None) => Some((co, o)),
@@ -153,44 +157,45 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
         (cost < self.sah.leaf(refs.len()) || refs.len() > self.max_leaf).then_some(split)
     }
 
-    /// Binned SAH over reference centroids (Wald 2007): cost, split, and the two children's
-    /// boxes (for the overlap test).
-    fn object_split(&self, refs: &[Ref], bounds: &Aabb) -> Option<(f32, Split, Aabb, Aabb)> {
-        let nb = self.bins;
-        let cb = Aabb::from_points(refs.iter().map(|r| r.bounds.centroid()));
-        let mut best: Option<(f32, Split, Aabb, Aabb)> = None;
-        for axis in 0..3 {
-            let (lo, hi) = (cb.min[axis], cb.max[axis]);
-            if hi <= lo {
-                continue;
-            }
-            let scale = nb as f32 / (hi - lo);
-            let mut bin_bounds = vec![Aabb::EMPTY; nb];
-            let mut bin_count = vec![0usize; nb];
-            for r in refs {
-                let b = bin_of(r.bounds.centroid()[axis], lo, scale, nb);
-                bin_bounds[b] = bin_bounds[b].union(r.bounds);
-                bin_count[b] += 1;
-            }
-            let sweep = Sweep::new(&bin_bounds, &bin_count, &bin_count);
-            for p in 1..nb {
-                let (left, nl, right, nr) = sweep.at(p);
-                if nl == 0 || nr == 0 {
-                    continue;
-                }
-                let cost = self.sah.split(bounds, &left, nl, &right, nr);
-                if best.as_ref().is_none_or(|b| cost < b.0) {
-                    best = Some((cost, Split::Object { axis, plane: p, lo, scale }, left, right));
+    /// Binned SAH over reference centroids (Wald 2007), the three axes binned in one pass:
+    /// cost, split, and the two children's boxes (for the overlap test). Small nodes get
+    /// fewer bins (4 + n/20, at most `bins`), as in Embree and the binned builder: most
+    /// nodes are small, and there clearing and sweeping bins cost more than binning.
+    fn object_split(&self, refs: &[Ref], bounds: &Aabb, centroids: &Aabb, s: &mut Scratch) -> Option<(f32, Split, Aabb, Aabb)> {
+        let nb = self.bins.min(4 + refs.len() / 20);
+        let (lo, hi) = (centroids.min, centroids.max);
+        let scale = [0, 1, 2].map(|a| if hi[a] > lo[a] { nb as f32 / (hi[a] - lo[a]) } else { 0.0 });
+        s.clear(nb);
+        for r in refs {
+            let c = r.bounds.centroid();
+            for axis in 0..3 {
+                if scale[axis] > 0.0 {
+                    let b = axis * nb + bin_of(c[axis], lo[axis], scale[axis], nb);
+                    s.bounds[b] = s.bounds[b].union(r.bounds);
+                    s.enter[b] += 1;
                 }
             }
         }
-        best
+        let mut best: Option<(f32, usize, usize)> = None;
+        for (axis, &sc) in scale.iter().enumerate() {
+            if sc > 0.0 {
+                let bins = axis * nb..(axis + 1) * nb;
+                if let Some((cost, p)) = self.sweep(bounds, &s.bounds[bins.clone()], &s.enter[bins.clone()], &s.enter[bins], &mut s.suffix) {
+                    if best.is_none_or(|b| cost < b.0) {
+                        best = Some((cost, axis, p));
+                    }
+                }
+            }
+        }
+        let (cost, axis, p) = best?;
+        let (left, right) = s.sides(axis, nb, p);
+        Some((cost, Split::Object { axis, plane: p, lo: lo[axis], scale: scale[axis], bins: nb }, left, right))
     }
 
     /// Binned spatial split (Stich et al. 2009, §4.2): bins are equal slabs of the node's
     /// box; each reference is chopped into the bins it spans, counted as entering its first
     /// bin and leaving its last, so a plane's left side counts entries and its right exits.
-    fn spatial_split(&self, refs: &[Ref], bounds: &Aabb) -> Option<(f32, Split)> {
+    fn spatial_split(&self, refs: &[Ref], bounds: &Aabb, s: &mut Scratch) -> Option<(f32, Split)> {
         let nb = self.bins;
         let mut best: Option<(f32, Split)> = None;
         for axis in 0..3 {
@@ -201,14 +206,14 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
             let width = (hi - lo) / nb as f32;
             let scale = nb as f32 / (hi - lo);
             let plane = |k: usize| if k == nb { hi } else { lo + k as f32 * width };
-            let mut bin_bounds = vec![Aabb::EMPTY; nb];
-            let (mut enter, mut exit) = (vec![0usize; nb], vec![0usize; nb]);
+            s.clear(nb);
+            let (bins, enter, exit) = (&mut s.bounds[..nb], &mut s.enter[..nb], &mut s.exit[..nb]);
             for r in refs {
                 let first = bin_of(r.bounds.min[axis], lo, scale, nb);
                 let last = bin_of(r.bounds.max[axis], lo, scale, nb).max(first);
                 enter[first] += 1;
                 exit[last] += 1;
-                for (k, bin) in bin_bounds.iter_mut().enumerate().take(last + 1).skip(first) {
+                for (k, bin) in bins.iter_mut().enumerate().take(last + 1).skip(first) {
                     let mut slab = r.bounds;
                     slab.min[axis] = slab.min[axis].max(plane(k));
                     slab.max[axis] = slab.max[axis].min(plane(k + 1));
@@ -221,16 +226,41 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
                     }
                 }
             }
-            let sweep = Sweep::new(&bin_bounds, &enter, &exit);
-            for p in 1..nb {
-                let (left, nl, right, nr) = sweep.at(p);
-                if nl == 0 || nr == 0 {
-                    continue;
-                }
-                let cost = self.sah.split(bounds, &left, nl, &right, nr);
+            if let Some((cost, p)) = self.sweep(bounds, &s.bounds[..nb], &s.enter[..nb], &s.exit[..nb], &mut s.suffix) {
                 if best.as_ref().is_none_or(|b| cost < b.0) {
-                    best = Some((cost, Split::Spatial { axis, pos: plane(p), left, right, n_left: nl, n_right: nr }));
+                    let (left, right) = s.sides(0, nb, p);
+                    let (n_left, n_right) = (s.enter[..p].iter().sum::<u32>() as usize, s.exit[p..nb].iter().sum::<u32>() as usize);
+                    best = Some((cost, Split::Spatial { axis, pos: plane(p), left, right, n_left, n_right }));
                 }
+            }
+        }
+        best
+    }
+
+    /// The cheapest plane `p` (1..bins) between `bins[..p]`, counted by `left_count`, and
+    /// `bins[p..]`, counted by `right_count`, with both sides non-empty: a suffix pass, then
+    /// a prefix pass evaluating the SAH; the first of equal costs wins. `suffix` is scratch.
+    fn sweep(&self, parent: &Aabb, bins: &[Aabb], left_count: &[u32], right_count: &[u32], suffix: &mut [(f32, u32)]) -> Option<(f32, usize)> {
+        let nb = bins.len();
+        let (mut right, mut nr) = (Aabb::EMPTY, 0u32);
+        for k in (1..nb).rev() {
+            right = right.union(bins[k]);
+            nr += right_count[k];
+            suffix[k] = (right.half_area(), nr);
+        }
+        let pa = parent.half_area();
+        let (mut left, mut nl) = (Aabb::EMPTY, 0u32);
+        let mut best: Option<(f32, usize)> = None;
+        for p in 1..nb {
+            left = left.union(bins[p - 1]);
+            nl += left_count[p - 1];
+            let (right_area, nr) = suffix[p];
+            if nl == 0 || nr == 0 {
+                continue;
+            }
+            let cost = self.sah.split_areas(pa, left.half_area(), nl as usize, right_area, nr as usize);
+            if best.is_none_or(|b| cost < b.0) {
+                best = Some((cost, p));
             }
         }
         best
@@ -245,17 +275,16 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
         (!b.is_empty()).then_some(b)
     }
 
-    /// Distributes `refs` between the children; `None` when one side would be empty.
-    fn apply(&self, refs: &[Ref], split: Split, budget: usize) -> Option<(Vec<Ref>, Vec<Ref>)> {
-        let (mut left, mut right) = (Vec::new(), Vec::new());
-        match split {
-            Split::Object { axis, plane, lo, scale } => {
-                for r in refs.iter() {
-                    let side = if bin_of(r.bounds.centroid()[axis], lo, scale, self.bins) < plane { &mut left } else { &mut right };
-                    side.push(*r);
-                }
+    /// Distributes `refs` between the children; gives `refs` back when one side would be
+    /// empty. An object split keeps the left side in `refs`' buffer.
+    fn apply(&self, mut refs: Vec<Ref>, split: Split, budget: usize) -> Result<(Vec<Ref>, Vec<Ref>), Vec<Ref>> {
+        let (left, right) = match split {
+            Split::Object { axis, plane, lo, scale, bins } => {
+                let right: Vec<Ref> = refs.extract_if(.., |r| bin_of(r.bounds.centroid()[axis], lo, scale, bins) >= plane).collect();
+                (refs, right)
             }
             Split::Spatial { axis, pos, left: lb, right: rb, n_left, n_right } => {
+                let (mut left, mut right) = (Vec::with_capacity(n_left), Vec::with_capacity(n_right));
                 let mut dups = 0;
                 for r in refs.iter() {
                     if r.bounds.max[axis] <= pos {
@@ -293,35 +322,45 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
                         (None, None) => left.push(*r),
                     }
                 }
+                (left, right)
             }
+        };
+        match (left.is_empty(), right.is_empty()) {
+            (false, false) => Ok((left, right)),
+            (true, _) => Err(right),
+            (false, true) => Err(left),
         }
-        (!left.is_empty() && !right.is_empty()).then_some((left, right))
     }
 }
 
-/// Prefix and suffix sums over bins: the left side of plane `p` is bins `..p`, counted by
-/// `left_count`, the right side bins `p..`, counted by `right_count`.
-struct Sweep {
-    left: Vec<(Aabb, usize)>,
-    right: Vec<(Aabb, usize)>,
+/// Bins of the three axes and the sweep's suffix sums, reused by every node a builder
+/// splits: no allocation per node.
+struct Scratch {
+    bounds: Vec<Aabb>,
+    /// Object splits: references per bin. Spatial splits: references entering a bin.
+    enter: Vec<u32>,
+    /// Spatial splits: references leaving a bin.
+    exit: Vec<u32>,
+    suffix: Vec<(f32, u32)>,
 }
 
-impl Sweep {
-    fn new(bins: &[Aabb], left_count: &[usize], right_count: &[usize]) -> Self {
-        let nb = bins.len();
-        let mut left = vec![(Aabb::EMPTY, 0); nb + 1];
-        let mut right = vec![(Aabb::EMPTY, 0); nb + 1];
-        for k in 0..nb {
-            left[k + 1] = (left[k].0.union(bins[k]), left[k].1 + left_count[k]);
-        }
-        for k in (0..nb).rev() {
-            right[k] = (right[k + 1].0.union(bins[k]), right[k + 1].1 + right_count[k]);
-        }
-        Self { left, right }
+impl Scratch {
+    fn new(bins: usize) -> Self {
+        Self { bounds: vec![Aabb::EMPTY; 3 * bins], enter: vec![0; 3 * bins], exit: vec![0; 3 * bins], suffix: vec![(0.0, 0); bins] }
     }
 
-    fn at(&self, p: usize) -> (Aabb, usize, Aabb, usize) {
-        (self.left[p].0, self.left[p].1, self.right[p].0, self.right[p].1)
+    /// Empties the first `nb` bins of each axis.
+    fn clear(&mut self, nb: usize) {
+        self.bounds[..3 * nb].fill(Aabb::EMPTY);
+        self.enter[..3 * nb].fill(0);
+        self.exit[..3 * nb].fill(0);
+    }
+
+    /// The boxes left and right of plane `p` among the `nb` bins of `axis`.
+    fn sides(&self, axis: usize, nb: usize, p: usize) -> (Aabb, Aabb) {
+        let bins = &self.bounds[axis * nb..(axis + 1) * nb];
+        let union = |b: &[Aabb]| b.iter().fold(Aabb::EMPTY, |a, &x| a.union(x));
+        (union(&bins[..p]), union(&bins[p..]))
     }
 }
 
