@@ -13,6 +13,7 @@ pub mod lbvh;
 pub mod morton;
 mod node;
 pub mod ploc;
+mod prim_ref;
 mod sah;
 pub mod sbvh;
 pub(crate) mod traverse;

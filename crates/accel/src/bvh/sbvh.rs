@@ -13,6 +13,9 @@
 
 use raylab_core::Aabb;
 
+use glam::Vec3A;
+
+use super::prim_ref::{truncate, Box3, PrimRef, MAX_PRIMS};
 use super::{Bvh, BvhNode, SahCost, MAX_DEPTH};
 use crate::{leaf_margin, BuildOptions, Primitives};
 
@@ -25,19 +28,12 @@ const SPLIT_BUDGET: f32 = 1.0;
 /// Nodes with at least this many references build their two subtrees in parallel.
 const PARALLEL_THRESHOLD: usize = 4096;
 
-/// A reference to a primitive, bounded by the part of it inside this node.
-#[derive(Clone, Copy, Debug)]
-struct Ref {
-    bounds: Aabb,
-    prim: u32,
-}
-
 enum Split {
     /// Refs whose centroid falls in a bin (of `bins`) below `plane` go left.
     Object { axis: usize, plane: usize, lo: f32, scale: f32, bins: usize },
     /// A plane at `pos`; `left`, `right`, `n_left`, `n_right` are the children estimated by
     /// the bins, used to decide unsplitting.
-    Spatial { axis: usize, pos: f32, left: Aabb, right: Aabb, n_left: usize, n_right: usize },
+    Spatial { axis: usize, pos: f32, left: Box3, right: Box3, n_left: usize, n_right: usize },
 }
 
 struct Builder<'a, P: ?Sized> {
@@ -55,8 +51,10 @@ struct Builder<'a, P: ?Sized> {
 
 pub fn build<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions) -> Bvh {
     let n = prims.len();
-    let refs: Vec<Ref> = (0..n as u32).map(|i| Ref { bounds: prims.bounds(i), prim: i }).collect();
-    let root = refs.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds));
+    assert!(n < MAX_PRIMS, "SBVH: more than 2^30 primitives");
+    // A reference is bounded by the part of its primitive inside the node holding it.
+    let refs: Vec<PrimRef> = (0..n as u32).map(|i| PrimRef::new(prims.bounds(i).min.into(), prims.bounds(i).max.into(), i)).collect();
+    let root = refs.iter().fold(Box3::EMPTY, |b, r| b.union(r.bounds())).aabb();
     let mut b = Builder {
         prims,
         sah: SahCost::from_options(opts),
@@ -78,8 +76,13 @@ pub fn build<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions) -> Bvh {
 impl<P: Primitives + ?Sized> Builder<'_, P> {
     /// Builds the subtree over `refs` into `nodes[slot]`, allowing `budget` more duplicate
     /// references below; returns the box written.
-    fn node(&mut self, slot: usize, refs: Vec<Ref>, depth: usize, budget: usize, scratch: &mut Scratch) -> Aabb {
-        let (bounds, centroids) = refs.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), r| (b.union(r.bounds), c.grow(r.bounds.centroid())));
+    fn node(&mut self, slot: usize, refs: Vec<PrimRef>, depth: usize, budget: usize, scratch: &mut Scratch) -> Aabb {
+        let (mut bounds, mut centroids) = (Box3::EMPTY, Box3::EMPTY);
+        for r in &refs {
+            bounds.grow(r.min(), r.max);
+            let c = r.centroid();
+            centroids.grow(c, c);
+        }
         let n = refs.len();
         let split = if n <= 1 || depth >= MAX_DEPTH { None } else { self.split(&refs, &bounds, &centroids, budget, scratch) };
         let children = match split {
@@ -95,9 +98,10 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
                 (refs, right)
             }
             Err(refs) => {
-                let leaf = Aabb { min: bounds.min - self.margin, max: bounds.max + self.margin };
+                let b = bounds.aabb();
+                let leaf = Aabb { min: b.min - self.margin, max: b.max + self.margin };
                 self.nodes[slot] = BvhNode::leaf(leaf, self.indices.len() as u32, n as u32);
-                self.indices.extend(refs.iter().map(|r| r.prim));
+                self.indices.extend(refs.iter().map(|r| r.id()));
                 return leaf;
             }
         };
@@ -144,7 +148,7 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
 
     /// The cheaper of the best object and spatial splits, or `None` when a leaf is cheaper
     /// and allowed. `centroids` bounds the references' centroids.
-    fn split(&self, refs: &[Ref], bounds: &Aabb, centroids: &Aabb, budget: usize, scratch: &mut Scratch) -> Option<Split> {
+    fn split(&self, refs: &[PrimRef], bounds: &Box3, centroids: &Box3, budget: usize, scratch: &mut Scratch) -> Option<Split> {
         let object = self.object_split(refs, bounds, centroids, scratch);
         let overlap = object.as_ref().map_or(f32::INFINITY, |(_, _, l, r)| l.intersection(*r).half_area());
         let spatial = (budget > 0 && overlap > self.min_overlap).then(|| self.spatial_split(refs, bounds, scratch)).flatten();
@@ -161,17 +165,19 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
     /// cost, split, and the two children's boxes (for the overlap test). Small nodes get
     /// fewer bins (4 + n/20, at most `bins`), as in Embree and the binned builder: most
     /// nodes are small, and there clearing and sweeping bins cost more than binning.
-    fn object_split(&self, refs: &[Ref], bounds: &Aabb, centroids: &Aabb, s: &mut Scratch) -> Option<(f32, Split, Aabb, Aabb)> {
+    fn object_split(&self, refs: &[PrimRef], bounds: &Box3, centroids: &Box3, s: &mut Scratch) -> Option<(f32, Split, Box3, Box3)> {
         let nb = self.bins.min(4 + refs.len() / 20);
         let (lo, hi) = (centroids.min, centroids.max);
         let scale = [0, 1, 2].map(|a| if hi[a] > lo[a] { nb as f32 / (hi[a] - lo[a]) } else { 0.0 });
         s.clear(nb);
+        let (scale_v, top) = (Vec3A::from(scale), Vec3A::splat((nb - 1) as f32));
         for r in refs {
-            let c = r.bounds.centroid();
+            // `bin_of` on the three axes at once: in [0, nb - 1], a NaN made 0 by `max`.
+            let bin = truncate(((r.centroid() - lo) * scale_v).max(Vec3A::ZERO).min(top));
             for axis in 0..3 {
                 if scale[axis] > 0.0 {
-                    let b = axis * nb + bin_of(c[axis], lo[axis], scale[axis], nb);
-                    s.bounds[b] = s.bounds[b].union(r.bounds);
+                    let b = axis * nb + bin[axis] as usize;
+                    s.bounds[b].grow(r.min(), r.max);
                     s.enter[b] += 1;
                 }
             }
@@ -195,7 +201,7 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
     /// Binned spatial split (Stich et al. 2009, §4.2): bins are equal slabs of the node's
     /// box; each reference is chopped into the bins it spans, counted as entering its first
     /// bin and leaving its last, so a plane's left side counts entries and its right exits.
-    fn spatial_split(&self, refs: &[Ref], bounds: &Aabb, s: &mut Scratch) -> Option<(f32, Split)> {
+    fn spatial_split(&self, refs: &[PrimRef], bounds: &Box3, s: &mut Scratch) -> Option<(f32, Split)> {
         let nb = self.bins;
         let mut best: Option<(f32, Split)> = None;
         for axis in 0..3 {
@@ -207,22 +213,27 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
             let scale = nb as f32 / (hi - lo);
             let plane = |k: usize| if k == nb { hi } else { lo + k as f32 * width };
             s.clear(nb);
-            let (bins, enter, exit) = (&mut s.bounds[..nb], &mut s.enter[..nb], &mut s.exit[..nb]);
+            // Bin `k` as bounds to clamp a box to: its planes on `axis`, infinite elsewhere.
+            for k in 0..nb {
+                let (mut below, mut above) = (Vec3A::NEG_INFINITY, Vec3A::INFINITY);
+                below[axis] = plane(k);
+                above[axis] = plane(k + 1);
+                s.slabs[k] = (below, above);
+            }
+            let (bins, enter, exit, slabs) = (&mut s.bounds[..nb], &mut s.enter[..nb], &mut s.exit[..nb], &s.slabs[..nb]);
             for r in refs {
-                let first = bin_of(r.bounds.min[axis], lo, scale, nb);
-                let last = bin_of(r.bounds.max[axis], lo, scale, nb).max(first);
+                let first = bin_of(r.min()[axis], lo, scale, nb);
+                let last = bin_of(r.max[axis], lo, scale, nb).max(first);
                 enter[first] += 1;
                 exit[last] += 1;
-                for (k, bin) in bins.iter_mut().enumerate().take(last + 1).skip(first) {
-                    let mut slab = r.bounds;
-                    slab.min[axis] = slab.min[axis].max(plane(k));
-                    slab.max[axis] = slab.max[axis].min(plane(k + 1));
+                for (bin, &(below, above)) in bins[first..=last].iter_mut().zip(&slabs[first..=last]) {
                     // The reference's box cut by the bin, not the primitive clipped to it:
                     // exact clipping in every bin a reference spans made the build 2.5x
                     // slower for a tree 1 % better (docs/performance.md, fifth round);
                     // `apply` clips the references it splits exactly.
+                    let slab = Box3 { min: r.min().max(below), max: r.max.min(above) };
                     if !slab.is_empty() {
-                        *bin = bin.union(slab);
+                        bin.grow(slab.min, slab.max);
                     }
                 }
             }
@@ -240,16 +251,16 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
     /// The cheapest plane `p` (1..bins) between `bins[..p]`, counted by `left_count`, and
     /// `bins[p..]`, counted by `right_count`, with both sides non-empty: a suffix pass, then
     /// a prefix pass evaluating the SAH; the first of equal costs wins. `suffix` is scratch.
-    fn sweep(&self, parent: &Aabb, bins: &[Aabb], left_count: &[u32], right_count: &[u32], suffix: &mut [(f32, u32)]) -> Option<(f32, usize)> {
+    fn sweep(&self, parent: &Box3, bins: &[Box3], left_count: &[u32], right_count: &[u32], suffix: &mut [(f32, u32)]) -> Option<(f32, usize)> {
         let nb = bins.len();
-        let (mut right, mut nr) = (Aabb::EMPTY, 0u32);
+        let (mut right, mut nr) = (Box3::EMPTY, 0u32);
         for k in (1..nb).rev() {
             right = right.union(bins[k]);
             nr += right_count[k];
             suffix[k] = (right.half_area(), nr);
         }
         let pa = parent.half_area();
-        let (mut left, mut nl) = (Aabb::EMPTY, 0u32);
+        let (mut left, mut nl) = (Box3::EMPTY, 0u32);
         let mut best: Option<(f32, usize)> = None;
         for p in 1..nb {
             left = left.union(bins[p - 1]);
@@ -267,58 +278,60 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
     }
 
     /// The part of primitive `prim` inside `clip`, or `None` when there is none.
-    fn clip(&self, prim: u32, clip: &Aabb) -> Option<Aabb> {
+    fn clip(&self, prim: u32, clip: &Box3) -> Option<Box3> {
         if clip.is_empty() {
             return None;
         }
-        let b = self.prims.clipped_bounds(prim, clip).intersection(*clip);
-        (!b.is_empty()).then_some(b)
+        let clip = clip.aabb();
+        let b = self.prims.clipped_bounds(prim, &clip).intersection(clip);
+        (!b.is_empty()).then(|| Box3::from_aabb(&b))
     }
 
     /// Distributes `refs` between the children; gives `refs` back when one side would be
     /// empty. An object split keeps the left side in `refs`' buffer.
-    fn apply(&self, mut refs: Vec<Ref>, split: Split, budget: usize) -> Result<(Vec<Ref>, Vec<Ref>), Vec<Ref>> {
+    fn apply(&self, mut refs: Vec<PrimRef>, split: Split, budget: usize) -> Result<(Vec<PrimRef>, Vec<PrimRef>), Vec<PrimRef>> {
         let (left, right) = match split {
             Split::Object { axis, plane, lo, scale, bins } => {
-                let right: Vec<Ref> = refs.extract_if(.., |r| bin_of(r.bounds.centroid()[axis], lo, scale, bins) >= plane).collect();
+                let right: Vec<PrimRef> = refs.extract_if(.., |r| bin_of(r.centroid()[axis], lo, scale, bins) >= plane).collect();
                 (refs, right)
             }
             Split::Spatial { axis, pos, left: lb, right: rb, n_left, n_right } => {
                 let (mut left, mut right) = (Vec::with_capacity(n_left), Vec::with_capacity(n_right));
                 let mut dups = 0;
                 for r in refs.iter() {
-                    if r.bounds.max[axis] <= pos {
+                    if r.max[axis] <= pos {
                         left.push(*r);
                         continue;
                     }
-                    if r.bounds.min[axis] >= pos {
+                    if r.min()[axis] >= pos {
                         right.push(*r);
                         continue;
                     }
-                    let (mut below, mut above) = (r.bounds, r.bounds);
+                    let (mut below, mut above) = (r.bounds(), r.bounds());
                     below.max[axis] = pos;
                     above.min[axis] = pos;
-                    match (self.clip(r.prim, &below), self.clip(r.prim, &above)) {
+                    let half = |b: Box3| PrimRef::new(b.min, b.max, r.id());
+                    match (self.clip(r.id(), &below), self.clip(r.id(), &above)) {
                         (Some(b), Some(a)) => {
                             // Reference unsplitting (§4.3): keep the whole reference on one
                             // side when that is cheaper than both halves, and always once
                             // the duplication budget is spent.
                             let (nl, nr) = (n_left as f32, n_right as f32);
                             let split = lb.half_area() * nl + rb.half_area() * nr;
-                            let only_left = lb.union(r.bounds).half_area() * nl + rb.half_area() * (nr - 1.0);
-                            let only_right = lb.half_area() * (nl - 1.0) + rb.union(r.bounds).half_area() * nr;
+                            let only_left = lb.union(r.bounds()).half_area() * nl + rb.half_area() * (nr - 1.0);
+                            let only_right = lb.half_area() * (nl - 1.0) + rb.union(r.bounds()).half_area() * nr;
                             if dups < budget && split < only_left.min(only_right) {
                                 dups += 1;
-                                left.push(Ref { bounds: b, prim: r.prim });
-                                right.push(Ref { bounds: a, prim: r.prim });
+                                left.push(half(b));
+                                right.push(half(a));
                             } else if only_left <= only_right {
                                 left.push(*r);
                             } else {
                                 right.push(*r);
                             }
                         }
-                        (Some(b), None) => left.push(Ref { bounds: b, prim: r.prim }),
-                        (None, Some(a)) => right.push(Ref { bounds: a, prim: r.prim }),
+                        (Some(b), None) => left.push(half(b)),
+                        (None, Some(a)) => right.push(half(a)),
                         (None, None) => left.push(*r),
                     }
                 }
@@ -336,30 +349,32 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
 /// Bins of the three axes and the sweep's suffix sums, reused by every node a builder
 /// splits: no allocation per node.
 struct Scratch {
-    bounds: Vec<Aabb>,
+    bounds: Vec<Box3>,
     /// Object splits: references per bin. Spatial splits: references entering a bin.
     enter: Vec<u32>,
     /// Spatial splits: references leaving a bin.
     exit: Vec<u32>,
     suffix: Vec<(f32, u32)>,
+    /// Spatial splits: each bin's planes (see `spatial_split`).
+    slabs: Vec<(Vec3A, Vec3A)>,
 }
 
 impl Scratch {
     fn new(bins: usize) -> Self {
-        Self { bounds: vec![Aabb::EMPTY; 3 * bins], enter: vec![0; 3 * bins], exit: vec![0; 3 * bins], suffix: vec![(0.0, 0); bins] }
+        Self { bounds: vec![Box3::EMPTY; 3 * bins], enter: vec![0; 3 * bins], exit: vec![0; 3 * bins], suffix: vec![(0.0, 0); bins], slabs: vec![(Vec3A::ZERO, Vec3A::ZERO); bins] }
     }
 
     /// Empties the first `nb` bins of each axis.
     fn clear(&mut self, nb: usize) {
-        self.bounds[..3 * nb].fill(Aabb::EMPTY);
+        self.bounds[..3 * nb].fill(Box3::EMPTY);
         self.enter[..3 * nb].fill(0);
         self.exit[..3 * nb].fill(0);
     }
 
     /// The boxes left and right of plane `p` among the `nb` bins of `axis`.
-    fn sides(&self, axis: usize, nb: usize, p: usize) -> (Aabb, Aabb) {
+    fn sides(&self, axis: usize, nb: usize, p: usize) -> (Box3, Box3) {
         let bins = &self.bounds[axis * nb..(axis + 1) * nb];
-        let union = |b: &[Aabb]| b.iter().fold(Aabb::EMPTY, |a, &x| a.union(x));
+        let union = |b: &[Box3]| b.iter().fold(Box3::EMPTY, |a, &x| a.union(x));
         (union(&bins[..p]), union(&bins[p..]))
     }
 }
