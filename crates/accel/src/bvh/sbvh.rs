@@ -172,8 +172,7 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
         s.clear(nb);
         let (lo, scale_v, top) = (fourth_lane_zero(lo.to_array()), fourth_lane_zero(scale), Vec3A::splat((nb - 1) as f32));
         for r in refs {
-            // `bin_of` on the three axes at once: in [0, nb - 1], a NaN made 0 by `max`.
-            let bin = truncate(((r.centroid() - lo) * scale_v).max(Vec3A::ZERO).min(top));
+            let bin = bins3(r.centroid(), lo, scale_v, top);
             for axis in 0..3 {
                 if scale[axis] > 0.0 {
                     let b = axis * nb + bin[axis] as usize;
@@ -221,9 +220,8 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
         }
         let (lo, scale_v, top) = (fourth_lane_zero(lo.to_array()), fourth_lane_zero(scale), Vec3A::splat((nb - 1) as f32));
         for r in refs {
-            // `bin_of` of the box's two corners on the three axes at once.
-            let first = truncate(((r.min() - lo) * scale_v).max(Vec3A::ZERO).min(top));
-            let last = truncate(((r.max - lo) * scale_v).max(Vec3A::ZERO).min(top));
+            // The bins of the box's two corners.
+            let (first, last) = (bins3(r.min(), lo, scale_v, top), bins3(r.max, lo, scale_v, top));
             for axis in (0..3).filter(|&a| axes[a]) {
                 let (f, l) = (axis * nb + first[axis] as usize, axis * nb + last[axis].max(first[axis]) as usize);
                 s.enter[f] += 1;
@@ -394,7 +392,43 @@ fn fourth_lane_zero(v: [f32; 3]) -> Vec3A {
     Vec3A::from_vec4(glam::Vec4::new(v[0], v[1], v[2], 0.0))
 }
 
+/// [`bin_of`] on the three axes at once: `lo` and `scale` from [`fourth_lane_zero`], `top`
+/// the last bin. A NaN (an infinite scale times a zero offset) becomes 0 at `max`.
+#[inline]
+fn bins3(x: Vec3A, lo: Vec3A, scale: Vec3A, top: Vec3A) -> [u32; 3] {
+    truncate(((x - lo) * scale).max(Vec3A::ZERO).min(top))
+}
+
 #[inline]
 fn bin_of(x: f32, lo: f32, scale: f32, nb: usize) -> usize {
     (((x - lo) * scale).max(0.0) as usize).min(nb - 1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The vector binning of the splits gives `bin_of`'s bins on each axis, at the edges
+    /// too: below the origin, on the last plane, beyond it, infinite and NaN offsets (an
+    /// infinite scale times a zero offset), with a PrimRef's index in the fourth lane.
+    #[test]
+    fn vector_binning_matches_bin_of() {
+        let nb = 16;
+        let top = Vec3A::splat((nb - 1) as f32);
+        let lo = [-1.0f32, 0.0, 2.5];
+        let scales = [[16.0 / 3.0, 0.5, 1e-3], [f32::INFINITY, 16.0, 0.0]];
+        let xs = [-1.0f32, -1.5, 0.0, 1e-30, 0.1875, 2.0, 2.999, 3.0, 1e9, f32::INFINITY, f32::NEG_INFINITY, 2.5, 5.5];
+        for scale in scales {
+            let (lo_v, scale_v) = (fourth_lane_zero(lo), fourth_lane_zero(scale));
+            for &x in &xs {
+                for &id in &[0u32, 7, 123_456] {
+                    let r = PrimRef::new(Vec3A::splat(x), Vec3A::splat(x), id);
+                    let bins = bins3(r.min(), lo_v, scale_v, top);
+                    for a in 0..3 {
+                        assert_eq!(bins[a] as usize, bin_of(x, lo[a], scale[a], nb), "x {x}, axis {a}, scale {}", scale[a]);
+                    }
+                }
+            }
+        }
+    }
 }
