@@ -192,12 +192,38 @@ pub struct BlockHits {
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 pub fn triangles_sse(b: &TriBlock, s: &ShearedRay, t_min: f32, t_max: f32) -> BlockHits {
+    triangles_sse_for(b, &BlockRay::new(s), t_min, t_max)
+}
+
+/// A [`ShearedRay`]'s constants in the order the block test reads them, picked once per
+/// ray: the origin's components along the shear axes `kx`, `ky`, `kz`, the shear, and the
+/// axes. (Picking `origin[kx]` per block took about a fifth of a missed block's
+/// instructions: a run-time index into a `Vec3` is a chain of branches.)
+#[derive(Clone, Copy, Debug)]
+pub struct BlockRay {
+    pub origin: [f32; 3],
+    pub shear: [f32; 3],
+    pub axes: [usize; 3],
+}
+
+impl BlockRay {
+    #[inline(always)]
+    pub fn new(s: &ShearedRay) -> Self {
+        let o = s.origin.to_array();
+        Self { origin: [o[s.kx], o[s.ky], o[s.kz]], shear: [s.sx, s.sy, s.sz], axes: [s.kx, s.ky, s.kz] }
+    }
+}
+
+/// [`triangles_sse`] with the ray's constants picked already ([`BlockRay`]).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub fn triangles_sse_for(b: &TriBlock, s: &BlockRay, t_min: f32, t_max: f32) -> BlockHits {
     use std::arch::x86_64::*;
-    let (kx, ky, kz) = (s.kx, s.ky, s.kz);
+    let [kx, ky, kz] = s.axes;
     // SAFETY: SSE2 is in the x86-64 baseline; every row holds 4 f32 and `prim` 4 u32.
     unsafe {
-        let (ox, oy, oz) = (_mm_set1_ps(s.origin[kx]), _mm_set1_ps(s.origin[ky]), _mm_set1_ps(s.origin[kz]));
-        let (sx, sy, sz) = (_mm_set1_ps(s.sx), _mm_set1_ps(s.sy), _mm_set1_ps(s.sz));
+        let (ox, oy, oz) = (_mm_set1_ps(s.origin[0]), _mm_set1_ps(s.origin[1]), _mm_set1_ps(s.origin[2]));
+        let (sx, sy, sz) = (_mm_set1_ps(s.shear[0]), _mm_set1_ps(s.shear[1]), _mm_set1_ps(s.shear[2]));
         // Per vertex: sheared x, y, and the depth `a[kz]` before scaling.
         let project = |v: usize| {
             let az = _mm_sub_ps(_mm_loadu_ps(b.p[v][kz].as_ptr()), oz);

@@ -16,7 +16,7 @@ use raylab_core::Ray;
 
 #[cfg(target_arch = "x86_64")]
 use super::kernels::slabs_avx2;
-use super::kernels::{RayBoxes, ROBUST_FAR};
+use super::kernels::{BlockRay, RayBoxes, ROBUST_FAR};
 use super::node::{is_leaf, ChildRef, Layout, TriBlock, WideNode, EMPTY};
 use super::traverse::{block_closest, child_boxes, insert_sorted, leaf_slice, occupied, STACK};
 use super::WideBvh;
@@ -213,7 +213,7 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
                     c.prim_tests += occupied(b) * u64::from(active.count_ones());
                 }
                 for r in bits(active) {
-                    block_closest::<P, SIMD>(b, prims, &sheared[r], &mut ray[r], &mut out[r]);
+                    block_closest::<P, SIMD>(b, prims, &sheared[r], &BlockRay::new(&sheared[r]), &mut ray[r], &mut out[r]);
                     far.0[r] = ray[r].t_max * ROBUST_FAR;
                 }
             }

@@ -27,7 +27,7 @@ use std::mem::MaybeUninit;
 use raylab_core::intersect::ShearedRay;
 use raylab_core::{gamma, Ray};
 
-use super::kernels::ROBUST_FAR;
+use super::kernels::{BlockRay, ROBUST_FAR};
 use super::node::{is_leaf, Layout, TriBlock, WideNode, EMPTY};
 use super::packet::{prefetch, PACKET};
 use super::traverse::{block_closest, exact_lane, insert_sorted, leaf_slice, occupied, wins, STACK};
@@ -349,7 +349,7 @@ fn few_in_leaf<P: Primitives + ?Sized>(blocks: &[TriBlock], prims: &P, rays: &[R
         let mut ray = Ray { t_max: lanes.t.0[r], ..rays[r] };
         let s = p.sheared(r);
         for b in blocks {
-            block_closest::<P, true>(b, prims, &s, &mut ray, &mut hit);
+            block_closest::<P, true>(b, prims, &s, &BlockRay::new(&s), &mut ray, &mut hit);
         }
         if let Some(h) = hit {
             (lanes.t.0[r], lanes.prim[r], lanes.u.0[r], lanes.v.0[r]) = (h.t, h.prim, h.u, h.v);

@@ -12,7 +12,7 @@ use std::mem::MaybeUninit;
 use raylab_core::intersect::ShearedRay;
 use raylab_core::Ray;
 
-use super::kernels::{boxes_portable, triangle_candidates, RayBoxes, ROBUST_FAR};
+use super::kernels::{boxes_portable, triangle_candidates, BlockRay, RayBoxes, ROBUST_FAR};
 
 use super::node::{is_leaf, leaf_blocks, ChildRef, Layout, TriBlock, WideNode, EMPTY};
 use super::WideBvh;
@@ -69,10 +69,10 @@ pub(super) fn wins(t: f32, prim: u32, best: &Option<Hit>) -> bool {
 /// ([`triangles_sse`](super::kernels::triangles_sse)) and only the lanes it cannot decide
 /// take a call.
 #[inline(always)]
-pub(super) fn block_closest<P: Primitives + ?Sized, const SIMD: bool>(b: &TriBlock, prims: &P, s: &ShearedRay, ray: &mut Ray, best: &mut Option<Hit>) {
+pub(super) fn block_closest<P: Primitives + ?Sized, const SIMD: bool>(b: &TriBlock, prims: &P, s: &ShearedRay, br: &BlockRay, ray: &mut Ray, best: &mut Option<Hit>) {
     #[cfg(target_arch = "x86_64")]
     if SIMD {
-        let h = super::kernels::triangles_sse(b, s, ray.t_min, ray.t_max);
+        let h = super::kernels::triangles_sse_for(b, br, ray.t_min, ray.t_max);
         let mut m = h.hit | h.exact;
         while m != 0 {
             let l = m.trailing_zeros() as usize;
@@ -101,10 +101,10 @@ pub(super) fn block_closest<P: Primitives + ?Sized, const SIMD: bool>(b: &TriBlo
 
 /// Whether any lane of block `b` is hit (see [`block_closest`]).
 #[inline(always)]
-fn block_any<P: Primitives + ?Sized, const SIMD: bool>(b: &TriBlock, prims: &P, s: &ShearedRay, ray: &Ray) -> bool {
+fn block_any<P: Primitives + ?Sized, const SIMD: bool>(b: &TriBlock, prims: &P, s: &ShearedRay, br: &BlockRay, ray: &Ray) -> bool {
     #[cfg(target_arch = "x86_64")]
     let mut m = if SIMD {
-        let h = super::kernels::triangles_sse(b, s, ray.t_min, ray.t_max);
+        let h = super::kernels::triangles_sse_for(b, br, ray.t_min, ray.t_max);
         if h.hit != 0 {
             return true;
         }
@@ -158,23 +158,23 @@ pub(super) fn occupied(b: &TriBlock) -> u64 {
 
 /// Closest hit among the blocks of a leaf; moves `ray.t_max` to each hit found.
 #[inline(always)]
-fn leaf_closest<P: Primitives + ?Sized, const SIMD: bool, const COUNT: bool>(blocks: &[TriBlock], prims: &P, s: &ShearedRay, ray: &mut Ray, best: &mut Option<Hit>, w: &mut Work) {
+fn leaf_closest<P: Primitives + ?Sized, const SIMD: bool, const COUNT: bool>(blocks: &[TriBlock], prims: &P, s: &ShearedRay, br: &BlockRay, ray: &mut Ray, best: &mut Option<Hit>, w: &mut Work) {
     for b in blocks {
         if COUNT {
             w.tests += occupied(b);
         }
-        block_closest::<P, SIMD>(b, prims, s, ray, best);
+        block_closest::<P, SIMD>(b, prims, s, br, ray, best);
     }
 }
 
 /// Whether anything in the blocks of a leaf is hit; stops at the first.
 #[inline(always)]
-fn leaf_any<P: Primitives + ?Sized, const SIMD: bool, const COUNT: bool>(blocks: &[TriBlock], prims: &P, s: &ShearedRay, ray: &Ray, w: &mut Work) -> bool {
+fn leaf_any<P: Primitives + ?Sized, const SIMD: bool, const COUNT: bool>(blocks: &[TriBlock], prims: &P, s: &ShearedRay, br: &BlockRay, ray: &Ray, w: &mut Work) -> bool {
     for b in blocks {
         if COUNT {
             w.tests += occupied(b);
         }
-        if block_any::<P, SIMD>(b, prims, s, ray) {
+        if block_any::<P, SIMD>(b, prims, s, br, ray) {
             return true;
         }
     }
@@ -199,6 +199,7 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
     // load of a few lanes out of a just-stored 32-byte copy misses store forwarding.
     let rb = RayBoxes::new(ray);
     let s = ShearedRay::new(ray);
+    let br = BlockRay::new(&s);
     let mut ray = *ray;
     let mut best = None;
     let mut w = Work::default();
@@ -210,7 +211,7 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
             w.nodes += 1;
         }
         if is_leaf(cur) {
-            leaf_closest::<P, SIMD, COUNT>(leaf_slice(bvh, cur), prims, &s, &mut ray, &mut best, &mut w);
+            leaf_closest::<P, SIMD, COUNT>(leaf_slice(bvh, cur), prims, &s, &br, &mut ray, &mut best, &mut w);
         } else {
             let node = &bvh.nodes[cur as usize];
             let mut tnear = [0.0f32; W];
@@ -282,6 +283,7 @@ pub(super) fn any<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SI
     }
     let rb = RayBoxes::new(ray);
     let s = ShearedRay::new(ray);
+    let br = BlockRay::new(&s);
     let mut w = Work::default();
     let mut stack = [const { MaybeUninit::<ChildRef>::uninit() }; STACK];
     let mut sp = 0usize;
@@ -292,7 +294,7 @@ pub(super) fn any<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SI
             w.nodes += 1;
         }
         if is_leaf(cur) {
-            if leaf_any::<P, SIMD, COUNT>(leaf_slice(bvh, cur), prims, &s, ray, &mut w) {
+            if leaf_any::<P, SIMD, COUNT>(leaf_slice(bvh, cur), prims, &s, &br, ray, &mut w) {
                 hit = true;
                 break;
             }
