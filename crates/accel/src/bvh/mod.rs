@@ -6,7 +6,8 @@
 //! (Morton codes, Karras 2012), `ploc.rs` (Meister & Bittner 2018) and `sbvh.rs` (spatial
 //! splits, Stich et al. 2009); the last two start from `morton.rs`' order. The walk,
 //! statistics and validation are the binary-tree code of `tree.rs`, shared with the sphere
-//! hierarchy; `traverse.rs` holds only the box test.
+//! hierarchy; `traverse.rs` holds only the box test. `prim_ref.rs` holds what the binned
+//! and spatial-split builders stream through: a box and its index in 32 bytes.
 
 mod build;
 pub mod lbvh;
