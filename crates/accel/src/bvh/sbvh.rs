@@ -181,18 +181,7 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
                 }
             }
         }
-        let mut best: Option<(f32, usize, usize)> = None;
-        for (axis, &sc) in scale.iter().enumerate() {
-            if sc > 0.0 {
-                let bins = axis * nb..(axis + 1) * nb;
-                if let Some((cost, p)) = self.sweep(bounds, &s.bounds[bins.clone()], &s.enter[bins.clone()], &s.enter[bins], &mut s.suffix) {
-                    if best.is_none_or(|b| cost < b.0) {
-                        best = Some((cost, axis, p));
-                    }
-                }
-            }
-        }
-        let (cost, axis, p) = best?;
+        let (cost, axis, p) = self.best_plane(bounds, s, nb, scale.map(|sc| sc > 0.0), false)?;
         let (left, right) = s.sides(axis, nb, p);
         Some((cost, Split::Object { axis, plane: p, lo: lo[axis], scale: scale[axis], bins: nb }, left, right))
     }
@@ -238,20 +227,29 @@ impl<P: Primitives + ?Sized> Builder<'_, P> {
                 }
             }
         }
+        let (cost, axis, p) = self.best_plane(bounds, s, nb, axes, true)?;
+        let (left, right) = s.sides(axis, nb, p);
+        let bins = axis * nb..(axis + 1) * nb;
+        let (n_left, n_right) = (s.enter[bins.start..bins.start + p].iter().sum::<u32>() as usize, s.exit[bins.start + p..bins.end].iter().sum::<u32>() as usize);
+        Some((cost, Split::Spatial { axis, pos: plane(axis, p), left, right, n_left, n_right }))
+    }
+
+    /// The cheapest `(cost, axis, plane)` over the binned `axes`: a plane's left side is
+    /// counted by `enter`, its right side by `exit` for a spatial split (references leaving
+    /// a bin) and by `enter` for an object split (references in a bin). The first of equal
+    /// costs wins, axis by axis.
+    fn best_plane(&self, bounds: &Box3, s: &mut Scratch, nb: usize, axes: [bool; 3], spatial: bool) -> Option<(f32, usize, usize)> {
         let mut best: Option<(f32, usize, usize)> = None;
         for axis in (0..3).filter(|&a| axes[a]) {
             let bins = axis * nb..(axis + 1) * nb;
-            if let Some((cost, p)) = self.sweep(bounds, &s.bounds[bins.clone()], &s.enter[bins.clone()], &s.exit[bins], &mut s.suffix) {
+            let right = if spatial { &s.exit[bins.clone()] } else { &s.enter[bins.clone()] };
+            if let Some((cost, p)) = self.sweep(bounds, &s.bounds[bins.clone()], &s.enter[bins], right, &mut s.suffix) {
                 if best.is_none_or(|b| cost < b.0) {
                     best = Some((cost, axis, p));
                 }
             }
         }
-        let (cost, axis, p) = best?;
-        let (left, right) = s.sides(axis, nb, p);
-        let bins = axis * nb..(axis + 1) * nb;
-        let (n_left, n_right) = (s.enter[bins.start..bins.start + p].iter().sum::<u32>() as usize, s.exit[bins.start + p..bins.end].iter().sum::<u32>() as usize);
-        Some((cost, Split::Spatial { axis, pos: plane(axis, p), left, right, n_left, n_right }))
+        best
     }
 
     /// The cheapest plane `p` (1..bins) between `bins[..p]`, counted by `left_count`, and
