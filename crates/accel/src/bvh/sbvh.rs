@@ -11,9 +11,8 @@
 //! Straddling references may be "unsplit" (§4.3): sent whole to one child when that costs
 //! less than duplicating them.
 
-use raylab_core::Aabb;
-
 use glam::Vec3A;
+use raylab_core::Aabb;
 
 use super::prim_ref::{truncate, Box3, PrimRef, MAX_PRIMS};
 use super::{Bvh, BvhNode, SahCost, MAX_DEPTH};
@@ -53,7 +52,12 @@ pub fn build<P: Primitives + ?Sized>(prims: &P, opts: &BuildOptions) -> Bvh {
     let n = prims.len();
     assert!(n < MAX_PRIMS, "SBVH: more than 2^30 primitives");
     // A reference is bounded by the part of its primitive inside the node holding it.
-    let refs: Vec<PrimRef> = (0..n as u32).map(|i| PrimRef::new(prims.bounds(i).min.into(), prims.bounds(i).max.into(), i)).collect();
+    let refs: Vec<PrimRef> = (0..n as u32)
+        .map(|i| {
+            let b = prims.bounds(i);
+            PrimRef::new(b.min.into(), b.max.into(), i)
+        })
+        .collect();
     let root = refs.iter().fold(Box3::EMPTY, |b, r| b.union(r.bounds())).aabb();
     let mut b = Builder {
         prims,
