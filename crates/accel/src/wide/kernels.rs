@@ -24,6 +24,10 @@ pub const ROBUST_FAR: f32 = 1.0 + 2.0 * gamma(3);
 /// The far distances' widening by [`ROBUST_FAR`] is folded into their inverse
 /// (`inv_far`): the product `(bound - origin) · (inv · R)` carries the same four roundings
 /// as `((bound - origin) · inv) · R`, so the same bound, for one multiplication less.
+///
+/// The eight (or four) boxes' entry and exit distances are reduced over the three axes in
+/// integer order ([`boxes_portable`]): on a chain that every node visit waits for, a
+/// vector integer `max` takes one cycle where a float `max` takes four.
 #[derive(Clone, Copy, Debug)]
 pub struct RayBoxes {
     pub origin: [f32; 3],
@@ -35,7 +39,12 @@ pub struct RayBoxes {
     /// slab distances once per ray instead of once per box.
     pub near: [usize; 3],
     pub far: [usize; 3],
+    /// `t_min`, with `-0` made `+0`.
     pub t_min: f32,
+    /// Whether the slab distances are reduced in integer order ([`boxes_portable`]): the
+    /// ray starts at `t_min >= 0` and no distance can be NaN (a finite origin and inverse
+    /// direction). Rays along an axis or reaching behind their origin take the float test.
+    pub by_bits: bool,
 }
 
 impl RayBoxes {
@@ -44,7 +53,9 @@ impl RayBoxes {
         let inv = ray.inv_dir().to_array();
         let near = [0, 1, 2].map(|a| if inv[a] < 0.0 { 3 + a } else { a });
         let far = [0, 1, 2].map(|a| if inv[a] < 0.0 { a } else { 3 + a });
-        Self { origin: ray.origin.to_array(), inv, inv_far: inv.map(|i| i * ROBUST_FAR), near, far, t_min: ray.t_min }
+        let t_min = if ray.t_min == 0.0 { 0.0 } else { ray.t_min };
+        let by_bits = t_min >= 0.0 && !ray.t_max.is_nan() && ray.origin.is_finite() && inv.iter().all(|i| i.is_finite());
+        Self { origin: ray.origin.to_array(), inv, inv_far: inv.map(|i| i * ROBUST_FAR), near, far, t_min, by_bits }
     }
 }
 
@@ -52,21 +63,45 @@ impl RayBoxes {
 /// and their entry distances. Callers pass `t_max` already widened by [`ROBUST_FAR`]:
 /// the entry distance of a flat box (coplanar triangles) may round a few ulps above the
 /// distance the triangle kernel computes for a hit inside it, and such a box must not be
-/// culled by that hit. A NaN slab distance (a ray lying in a slab's plane)
+/// culled by that hit. A NaN slab distance (a ray lying in a slab's plane, `0 · ∞`)
 /// constrains nothing, as in `Aabb::intersect`.
+///
+/// Rays whose distances cannot be NaN and start at `t_min >= 0` ([`RayBoxes::by_bits`],
+/// nearly all) reduce them in integer order: the entry distance is the greatest of `t_min`
+/// and the axes' near distances by their bits read as `i32`, the exit distance the least
+/// of `t_max` and the far distances, and a box is entered when entry `<=` exit as floats.
+/// Bits order non-negative floats as floats and put every negative one below them, so the
+/// entry distance is exactly the float maximum (a negative near distance never exceeds
+/// `t_min`), and the exit distance is the float minimum when no far distance is negative,
+/// and negative (the box missed) when one is. One corner differs from float order, on the
+/// safe side: a far distance of `-0` (an origin on the box's exit plane) makes the exit
+/// `-0` even when another axis's is negative, so the box is entered at `t = 0`.
 #[inline(always)]
 #[allow(clippy::needless_range_loop)] // lanes index the bound rows and `tnear` alike
 pub fn boxes_portable<const W: usize>(node: &WideNode<W>, r: &RayBoxes, t_max: f32, tnear: &mut [f32; W]) -> u32 {
     let mut mask = 0;
     for lane in 0..W {
-        let (mut t0, mut t1) = (r.t_min, t_max);
-        for a in 0..3 {
-            let near = (node.bounds[r.near[a]][lane] - r.origin[a]) * r.inv[a];
-            let far = (node.bounds[r.far[a]][lane] - r.origin[a]) * r.inv_far[a];
-            // Written as the SIMD max/min instructions behave: `max(a, b) = a > b ? a : b`.
-            t0 = if near > t0 { near } else { t0 };
-            t1 = if far < t1 { far } else { t1 };
-        }
+        let (t0, t1) = if !r.by_bits {
+            let (mut t0, mut t1) = (r.t_min, t_max);
+            for a in 0..3 {
+                let near = (node.bounds[r.near[a]][lane] - r.origin[a]) * r.inv[a];
+                let far = (node.bounds[r.far[a]][lane] - r.origin[a]) * r.inv_far[a];
+                // Written as the SIMD max/min instructions behave: `max(a, b) = a > b ? a : b`.
+                t0 = if near > t0 { near } else { t0 };
+                t1 = if far < t1 { far } else { t1 };
+            }
+            (t0, t1)
+        } else {
+            let key = |x: f32| x.to_bits() as i32;
+            let (mut t0, mut t1) = (key(r.t_min), key(t_max));
+            for a in 0..3 {
+                let near = (node.bounds[r.near[a]][lane] - r.origin[a]) * r.inv[a];
+                let far = (node.bounds[r.far[a]][lane] - r.origin[a]) * r.inv_far[a];
+                t0 = t0.max(key(near));
+                t1 = t1.min(key(far));
+            }
+            (f32::from_bits(t0 as u32), f32::from_bits(t1 as u32))
+        };
         tnear[lane] = t0;
         mask |= u32::from(t0 <= t1) << lane;
     }
@@ -98,39 +133,73 @@ pub unsafe fn boxes_avx2(node: &WideNode<8>, r: &RayBoxes, t_max: f32, tnear: &m
 #[target_feature(enable = "avx2")]
 pub unsafe fn slabs_avx2(node: &WideNode<8>, r: &RayBoxes, t_max: f32) -> (std::arch::x86_64::__m256, std::arch::x86_64::__m256) {
     use std::arch::x86_64::*;
-    let mut t0 = _mm256_set1_ps(r.t_min);
-    let mut t1 = _mm256_set1_ps(t_max);
-    for a in 0..3 {
-        let o = _mm256_set1_ps(r.origin[a]);
-        let inv = _mm256_set1_ps(r.inv[a]);
-        // SAFETY: each row holds 8 f32.
-        let (lo, hi) = unsafe { (_mm256_loadu_ps(node.bounds[r.near[a]].as_ptr()), _mm256_loadu_ps(node.bounds[r.far[a]].as_ptr())) };
-        let near = _mm256_mul_ps(_mm256_sub_ps(lo, o), inv);
-        let far = _mm256_mul_ps(_mm256_sub_ps(hi, o), _mm256_set1_ps(r.inv_far[a]));
-        // `max_ps(a, b)` returns `b` when either is NaN: a NaN slab is ignored.
-        t0 = _mm256_max_ps(near, t0);
-        t1 = _mm256_min_ps(far, t1);
-    }
-    (t0, t1)
+    // SAFETY: each row holds 8 f32.
+    let load = |row: usize| unsafe { _mm256_loadu_ps(node.bounds[row].as_ptr()) };
+    // SAFETY: AVX2 is enabled in this function.
+    unsafe { slabs_of_rows_avx2(&r.near.map(load), &r.far.map(load), r, t_max) }
 }
 
-/// [`boxes_portable`] for four lanes with SSE2 (part of every x86-64 CPU).
+/// [`slabs_avx2`] with the node's near and far planes loaded (packets load them once for
+/// all their rays).
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[inline]
+#[target_feature(enable = "avx2")]
+pub unsafe fn slabs_of_rows_avx2(lo: &[std::arch::x86_64::__m256; 3], hi: &[std::arch::x86_64::__m256; 3], r: &RayBoxes, t_max: f32) -> (std::arch::x86_64::__m256, std::arch::x86_64::__m256) {
+    use std::arch::x86_64::*;
+    let o = r.origin.map(|x| _mm256_set1_ps(x));
+    if !r.by_bits {
+        let (mut t0, mut t1) = (_mm256_set1_ps(r.t_min), _mm256_set1_ps(t_max));
+        for a in 0..3 {
+            let near = _mm256_mul_ps(_mm256_sub_ps(lo[a], o[a]), _mm256_set1_ps(r.inv[a]));
+            let far = _mm256_mul_ps(_mm256_sub_ps(hi[a], o[a]), _mm256_set1_ps(r.inv_far[a]));
+            // `max_ps(a, b)` returns `b` when either is NaN: a NaN slab is ignored.
+            t0 = _mm256_max_ps(near, t0);
+            t1 = _mm256_min_ps(far, t1);
+        }
+        return (t0, t1);
+    }
+    // Integer order (see `boxes_portable`).
+    let near = |a: usize| _mm256_castps_si256(_mm256_mul_ps(_mm256_sub_ps(lo[a], o[a]), _mm256_set1_ps(r.inv[a])));
+    let far = |a: usize| _mm256_castps_si256(_mm256_mul_ps(_mm256_sub_ps(hi[a], o[a]), _mm256_set1_ps(r.inv_far[a])));
+    let key = |x: f32| _mm256_set1_epi32(x.to_bits() as i32);
+    let t0 = _mm256_max_epi32(_mm256_max_epi32(near(0), near(1)), _mm256_max_epi32(near(2), key(r.t_min)));
+    let t1 = _mm256_min_epi32(_mm256_min_epi32(far(0), far(1)), _mm256_min_epi32(far(2), key(t_max)));
+    (_mm256_castsi256_ps(t0), _mm256_castsi256_ps(t1))
+}
+
+/// [`boxes_portable`] for four lanes with SSE2 (part of every x86-64 CPU), whose
+/// integer `max` and `min` of 32-bit lanes are a compare and a select.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 pub fn boxes_sse(node: &WideNode<4>, r: &RayBoxes, t_max: f32, tnear: &mut [f32; 4]) -> u32 {
     use std::arch::x86_64::*;
     // SAFETY: SSE2 is in the x86-64 baseline; the loads read 4 f32 of each row.
     unsafe {
-        let mut t0 = _mm_set1_ps(r.t_min);
-        let mut t1 = _mm_set1_ps(t_max);
-        for a in 0..3 {
-            let o = _mm_set1_ps(r.origin[a]);
-            let inv = _mm_set1_ps(r.inv[a]);
-            let near = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(node.bounds[r.near[a]].as_ptr()), o), inv);
-            let far = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(node.bounds[r.far[a]].as_ptr()), o), _mm_set1_ps(r.inv_far[a]));
-            t0 = _mm_max_ps(near, t0);
-            t1 = _mm_min_ps(far, t1);
-        }
+        let load = |row: usize| _mm_loadu_ps(node.bounds[row].as_ptr());
+        let o = r.origin.map(|x| _mm_set1_ps(x));
+        let (t0, t1) = if !r.by_bits {
+            let (mut t0, mut t1) = (_mm_set1_ps(r.t_min), _mm_set1_ps(t_max));
+            for (a, &o) in o.iter().enumerate() {
+                let near = _mm_mul_ps(_mm_sub_ps(load(r.near[a]), o), _mm_set1_ps(r.inv[a]));
+                let far = _mm_mul_ps(_mm_sub_ps(load(r.far[a]), o), _mm_set1_ps(r.inv_far[a]));
+                t0 = _mm_max_ps(near, t0);
+                t1 = _mm_min_ps(far, t1);
+            }
+            (t0, t1)
+        } else {
+            let select = |m: __m128i, a: __m128i, b: __m128i| _mm_or_si128(_mm_and_si128(m, a), _mm_andnot_si128(m, b));
+            let max = |a: __m128i, b: __m128i| select(_mm_cmpgt_epi32(a, b), a, b);
+            let min = |a: __m128i, b: __m128i| select(_mm_cmpgt_epi32(a, b), b, a);
+            let near = |a: usize| _mm_castps_si128(_mm_mul_ps(_mm_sub_ps(load(r.near[a]), o[a]), _mm_set1_ps(r.inv[a])));
+            let far = |a: usize| _mm_castps_si128(_mm_mul_ps(_mm_sub_ps(load(r.far[a]), o[a]), _mm_set1_ps(r.inv_far[a])));
+            let key = |x: f32| _mm_set1_epi32(x.to_bits() as i32);
+            let t0 = max(max(near(0), near(1)), max(near(2), key(r.t_min)));
+            let t1 = min(min(far(0), far(1)), min(far(2), key(t_max)));
+            (_mm_castsi128_ps(t0), _mm_castsi128_ps(t1))
+        };
         _mm_storeu_ps(tnear.as_mut_ptr(), t0);
         _mm_movemask_ps(_mm_cmple_ps(t0, t1)) as u32
     }
@@ -329,6 +398,96 @@ pub(super) mod tests {
         let back = Ray::segment(Vec3::new(-1.0, 0.5, 0.5), -Vec3::X, 0.0, 10.0);
         assert_eq!(boxes_portable(&n, &RayBoxes::new(&back), back.t_max, &mut t), 0b1000);
         assert_eq!(t[3], 1.0);
+    }
+
+    /// Integer order ([`RayBoxes::by_bits`]) enters the boxes the float order enters, at the
+    /// same distances to the bit (and beyond them only its corner's, at t = 0), and the SIMD kernels agree with the portable one to the
+    /// bit: random boxes (some flat), empty lanes, origins on box planes, `t_min` above
+    /// zero and far limits cutting boxes.
+    #[test]
+    fn integer_order_matches_float_order() {
+        let mut rng = raylab_core::Pcg32::new(11, 3);
+        let mut f = |s: f32| (rng.next_f32() - 0.5) * s;
+        let mut entered = 0;
+        for k in 0..20000 {
+            let mut n = WideNode::<8>::EMPTY_NODE;
+            let boxes: Vec<Aabb> = (0..1 + k % 8).map(|l| {
+                let lo = Vec3::new(f(4.0), f(4.0), f(4.0));
+                let mut ext = Vec3::new(f(2.0).abs(), f(2.0).abs(), f(2.0).abs());
+                ext[l % 3] *= if (k + l) % 5 == 0 { 0.0 } else { 1.0 };
+                Aabb::new(lo, lo + ext)
+            }).collect();
+            for (l, b) in boxes.iter().enumerate() {
+                n.set(l, b, l as u32);
+            }
+            let mut o = Vec3::new(f(8.0), f(8.0), f(8.0));
+            if k % 3 == 0 {
+                // On a plane of the first box.
+                let a = k % 9 / 3;
+                o[a] = if k % 2 == 0 { boxes[0].min[a] } else { boxes[0].max[a] };
+            }
+            // Aimed near a box's centre, so that most rays enter some.
+            let aim = boxes[k % boxes.len()];
+            let d = ((aim.min + aim.max) * 0.5 + Vec3::new(f(1.0), f(1.0), f(1.0)) - o).try_normalize().unwrap_or(Vec3::ONE.normalize());
+            let ray = Ray::segment(o, d, if k % 4 == 0 { 0.5 } else { 0.0 }, if k % 5 == 0 { 2.0 + f(2.0) } else { f32::INFINITY });
+            let r = RayBoxes::new(&ray);
+            assert!(r.by_bits, "ray {k}");
+            let float = RayBoxes { by_bits: false, ..r };
+            let t_max = ray.t_max * ROBUST_FAR;
+            let (mut tb, mut tf) = ([0.0f32; 8], [0.0f32; 8]);
+            let mb = boxes_portable(&n, &r, t_max, &mut tb);
+            let mf = boxes_portable(&n, &float, t_max, &mut tf);
+            assert_eq!(mb & mf, mf, "ray {k}: a box float order enters is missed");
+            for l in 0..8 {
+                if mf & (1 << l) != 0 {
+                    assert_eq!(tb[l].to_bits(), tf[l].to_bits(), "ray {k} lane {l}: entry distance");
+                } else if mb & (1 << l) != 0 {
+                    // The corner (`integer_order_enters_a_box_left_at_zero`).
+                    assert_eq!(tb[l].to_bits(), 0, "ray {k} lane {l}: entered where float order misses");
+                }
+            }
+            entered += mf.count_ones();
+            #[cfg(target_arch = "x86_64")]
+            {
+                if std::is_x86_feature_detected!("avx2") {
+                    let mut t8 = [0.0f32; 8];
+                    // SAFETY: AVX2 detected.
+                    assert_eq!(unsafe { boxes_avx2(&n, &r, t_max, &mut t8) }, mb, "ray {k}: AVX2");
+                    assert_eq!(t8.map(f32::to_bits), tb.map(f32::to_bits), "ray {k}: AVX2 distances");
+                }
+                let mut n4 = WideNode::<4>::EMPTY_NODE;
+                for (l, b) in boxes.iter().take(4).enumerate() {
+                    n4.set(l, b, l as u32);
+                }
+                let (mut t4, mut tp) = ([0.0f32; 4], [0.0f32; 4]);
+                let m4 = boxes_portable(&n4, &r, t_max, &mut tp);
+                assert_eq!(m4, mb & 0xF, "ray {k}: four wide");
+                assert_eq!(boxes_sse(&n4, &r, t_max, &mut t4), m4, "ray {k}: SSE2");
+                assert_eq!(t4.map(f32::to_bits), tp.map(f32::to_bits), "ray {k}: SSE2 distances");
+            }
+        }
+        assert!(entered > 5000, "too few boxes entered: {entered}");
+    }
+
+    /// Integer order's one corner: a ray starting on box `[0, 1]³`'s `x = 0` face, leaving it
+    /// along −x (exit distance −0), from above it in y (exit distance −2). Float order misses
+    /// the box; integer order enters it at t = 0, which costs a visit and changes no answer
+    /// (hits need t > t_min = 0).
+    #[test]
+    fn integer_order_enters_a_box_left_at_zero() {
+        let mut n = WideNode::<8>::EMPTY_NODE;
+        n.set(0, &Aabb::new(Vec3::ZERO, Vec3::ONE), 0);
+        let ray = Ray::new(Vec3::new(0.0, 2.0, 0.5), Vec3::new(-1.0, 0.5, 0.25));
+        let r = RayBoxes::new(&ray);
+        let mut t = [1.0f32; 8];
+        assert_eq!(boxes_portable(&n, &RayBoxes { by_bits: false, ..r }, f32::INFINITY, &mut t), 0);
+        assert_eq!(boxes_portable(&n, &r, f32::INFINITY, &mut t), 1);
+        assert_eq!(t[0].to_bits(), 0.0f32.to_bits());
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: AVX2 detected.
+            assert_eq!(unsafe { boxes_avx2(&n, &r, f32::INFINITY, &mut t) }, 1);
+        }
     }
 
     #[test]

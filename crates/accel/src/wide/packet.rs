@@ -15,7 +15,7 @@ use raylab_core::intersect::ShearedRay;
 use raylab_core::Ray;
 
 #[cfg(target_arch = "x86_64")]
-use super::kernels::slabs_avx2;
+use super::kernels::{slabs_avx2, slabs_of_rows_avx2};
 use super::kernels::{BlockRay, RayBoxes, ROBUST_FAR};
 use super::node::{is_leaf, ChildRef, Layout, TriBlock, WideNode, EMPTY};
 use super::traverse::{block_closest, child_boxes, insert_sorted, leaf_slice, occupied, STACK};
@@ -110,15 +110,8 @@ unsafe fn node_boxes_avx2(node: &WideNode<8>, rb: &[RayBoxes; PACKET], rows: Opt
         let lo = near_rows.map(load);
         let hi = far_rows.map(load);
         for r in bits(active) {
-            let b = &rb[r];
-            // As `slabs_avx2`, with the planes already loaded.
-            let mut t0 = _mm256_set1_ps(b.t_min);
-            let mut t1 = _mm256_set1_ps(far[r]);
-            for a in 0..3 {
-                let o = _mm256_set1_ps(b.origin[a]);
-                t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(lo[a], o), _mm256_set1_ps(b.inv[a])), t0);
-                t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(hi[a], o), _mm256_set1_ps(b.inv_far[a])), t1);
-            }
+            // SAFETY: AVX2 is enabled in this function.
+            let (t0, t1) = unsafe { slabs_of_rows_avx2(&lo, &hi, &rb[r], far[r]) };
             add(r, t0, t1);
         }
     } else {

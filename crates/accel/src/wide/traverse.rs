@@ -189,15 +189,21 @@ pub(super) fn leaf_slice<const W: usize, N: Layout<W>>(bvh: &WideBvh<W, N>, r: C
 
 #[inline(always)]
 pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SIMD: bool, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
+    // The per-ray constants are read from the caller's ray, not from the copy below: a
+    // load of a few lanes out of a just-stored 32-byte copy misses store forwarding.
+    let rb = RayBoxes::new(ray);
+    if SIMD && !rb.by_bits {
+        // Rays along an axis or reaching behind their origin (rare) take the portable
+        // kernels, which answer as the SIMD ones do: the SIMD box tests are then compiled
+        // for integer order alone, with no branch in the loop.
+        return closest::<P, W, N, false, COUNT>(bvh, prims, ray, c);
+    }
     if COUNT {
         c.rays += 1;
     }
     if bvh.root == EMPTY {
         return None;
     }
-    // The per-ray constants are read from the caller's ray, not from the copy below: a
-    // load of a few lanes out of a just-stored 32-byte copy misses store forwarding.
-    let rb = RayBoxes::new(ray);
     let s = ShearedRay::new(ray);
     let br = BlockRay::new(&s);
     let mut ray = *ray;
@@ -275,13 +281,17 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
 
 #[inline(always)]
 pub(super) fn any<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SIMD: bool, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
+    let rb = RayBoxes::new(ray);
+    if SIMD && !rb.by_bits {
+        // As in `closest`.
+        return any::<P, W, N, false, COUNT>(bvh, prims, ray, c);
+    }
     if COUNT {
         c.rays += 1;
     }
     if bvh.root == EMPTY {
         return false;
     }
-    let rb = RayBoxes::new(ray);
     let s = ShearedRay::new(ray);
     let br = BlockRay::new(&s);
     let mut w = Work::default();
