@@ -42,8 +42,9 @@ pub struct RayBoxes {
     /// `t_min`, with `-0` made `+0`.
     pub t_min: f32,
     /// Whether the slab distances are reduced in integer order ([`boxes_portable`]): the
-    /// ray starts at `t_min >= 0` and no distance can be NaN (a finite origin and inverse
-    /// direction). Rays along an axis or reaching behind their origin take the float test.
+    /// ray starts at `t_min >= 0` and no distance can be NaN (a finite inverse direction;
+    /// a valid ray's origin is finite). Rays along an axis or reaching behind their origin
+    /// take the float test.
     pub by_bits: bool,
 }
 
@@ -54,7 +55,7 @@ impl RayBoxes {
         let near = [0, 1, 2].map(|a| if inv[a] < 0.0 { 3 + a } else { a });
         let far = [0, 1, 2].map(|a| if inv[a] < 0.0 { a } else { 3 + a });
         let t_min = if ray.t_min == 0.0 { 0.0 } else { ray.t_min };
-        let by_bits = t_min >= 0.0 && !ray.t_max.is_nan() && ray.origin.is_finite() && inv.iter().all(|i| i.is_finite());
+        let by_bits = t_min >= 0.0 && inv.iter().all(|i| i.is_finite());
         Self { origin: ray.origin.to_array(), inv, inv_far: inv.map(|i| i * ROBUST_FAR), near, far, t_min, by_bits }
     }
 }
