@@ -335,17 +335,25 @@ fn halves(refs: &[PrimRef], mid: usize) -> Split {
 
 /// Bins of the three axes, `nb` per axis (axis-major, in the first `3 nb` entries): the union of the boxes whose
 /// centroid falls in each bin, and their count.
+///
+/// Binning keeps two sets of bins, one for the even primitives and one for the odd ones,
+/// and folds the second into the first at the end of [`Bins::add`]. Consecutive primitives
+/// of a mesh often fall in the same bin, and each update of a bin then waits for the
+/// previous one's store to reach its load (store forwarding plus the `min`/`max`): with
+/// two sets, two such chains run side by side.
 struct Bins {
     bounds: Vec<Box3>,
     count: Vec<usize>,
+    /// Where the second set starts: `3 nb` of the largest `nb` the bins were made for.
+    second: usize,
 }
 
 impl Bins {
     fn new(nb: usize) -> Self {
-        Self { bounds: vec![Box3::EMPTY; 3 * nb], count: vec![0; 3 * nb] }
+        Self { bounds: vec![Box3::EMPTY; 6 * nb], count: vec![0; 6 * nb], second: 3 * nb }
     }
 
-    /// Empties the first `nb` bins of each axis.
+    /// Empties the first `nb` bins of each axis (the second set is empty between calls).
     fn clear(&mut self, nb: usize) {
         self.bounds[..3 * nb].fill(Box3::EMPTY);
         self.count[..3 * nb].fill(0);
@@ -353,19 +361,35 @@ impl Bins {
 
     /// Bins `refs` along the three axes of the centroid box starting at `lo` with `scale`
     /// bins per unit (0 on axes of zero extent, whose bins are then never read). Unions and
-    /// counts are exact, so splitting the work over threads gives the same bins, hence the
-    /// same tree, whatever the thread count.
+    /// counts are exact, so splitting the work over threads or sets gives the same bins,
+    /// hence the same tree, whatever the thread count.
     #[inline]
     fn add(&mut self, refs: &[PrimRef], nb: usize, lo: Vec3A, scale: Vec3A) {
         let top = Vec3A::splat((nb - 1) as f32);
-        for r in refs {
+        let (bounds, more_bounds) = self.bounds.split_at_mut(self.second);
+        let (count, more_count) = self.count.split_at_mut(self.second);
+        let (bounds, count) = (&mut bounds[..3 * nb], &mut count[..3 * nb]);
+        let (more_bounds, more_count) = (&mut more_bounds[..3 * nb], &mut more_count[..3 * nb]);
+        let bin = |r: &PrimRef, bounds: &mut [Box3], count: &mut [usize]| {
             // In [0, nb - 1]: a NaN became 0 at `max`.
             let bin = truncate(((r.centroid() - lo) * scale).max(Vec3A::ZERO).min(top));
             for (axis, b) in bin.into_iter().enumerate() {
                 let k = axis * nb + b as usize;
-                self.bounds[k].grow(r.min(), r.max);
-                self.count[k] += 1;
+                bounds[k].grow(r.min(), r.max);
+                count[k] += 1;
             }
+        };
+        let mut pairs = refs.chunks_exact(2);
+        for pair in &mut pairs {
+            bin(&pair[0], bounds, count);
+            bin(&pair[1], more_bounds, more_count);
+        }
+        if let [r] = pairs.remainder() {
+            bin(r, bounds, count);
+        }
+        for k in 0..3 * nb {
+            bounds[k] = bounds[k].union(std::mem::replace(&mut more_bounds[k], Box3::EMPTY));
+            count[k] += std::mem::take(&mut more_count[k]);
         }
     }
 
@@ -467,6 +491,37 @@ mod tests {
     fn extents_equal(a: &Extent, b: &Extent) -> bool {
         let eq = |x: &Box3, y: &Box3| x.min == y.min && x.max == y.max;
         eq(&a.geom, &b.geom) && eq(&a.cent, &b.cent)
+    }
+
+    /// Binning in two sets gives the bins of one set, primitive by primitive, also over
+    /// calls that reuse the bins (the second set must be folded and emptied each time) and
+    /// for odd counts.
+    #[test]
+    fn two_sets_bin_as_one() {
+        let mut rng = raylab_core::Pcg32::new(7, 1);
+        let mut next = move || rng.next_f32();
+        let nb = 9;
+        let (lo, scale) = (Vec3A::ZERO, Vec3A::splat(nb as f32 / 10.0));
+        let mut bins = Bins::new(16);
+        for n in [1, 2, 7, 1000, 1001] {
+            let refs: Vec<PrimRef> = (0..n as u32)
+                .map(|id| {
+                    let min = Vec3A::new(next(), next(), next()) * 9.0;
+                    PrimRef::new(min, min + Vec3A::new(next(), next(), next()), id)
+                })
+                .collect();
+            bins.clear(nb);
+            bins.add(&refs, nb, lo, scale);
+            let (mut want_bounds, mut want_count) = (vec![Box3::EMPTY; 3 * nb], vec![0; 3 * nb]);
+            for r in &refs {
+                for (axis, b) in truncate(((r.centroid() - lo) * scale).max(Vec3A::ZERO).min(Vec3A::splat((nb - 1) as f32))).into_iter().enumerate() {
+                    want_bounds[axis * nb + b as usize].grow(r.min(), r.max);
+                    want_count[axis * nb + b as usize] += 1;
+                }
+            }
+            assert_eq!(&bins.count[..3 * nb], &want_count[..], "{n} primitives");
+            assert!(bins.bounds[..3 * nb].iter().zip(&want_bounds).all(|(a, b)| a.min == b.min && a.max == b.max), "{n} primitives");
+        }
     }
 
     /// Both partitions are the stable one: lefts then rights, each in input order, with the
