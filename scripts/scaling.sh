@@ -15,7 +15,8 @@
 # RAYLAB_SHARED (the shared `scenes` folder, default ../shared/scenes), OUT (default
 # target/scaling), THREADS (default "1 2 4 8 16"), MESHES (default "bunny dragon202k
 # dragon871k"; tetra adds a 4.2M-triangle procedural mesh), RESOLUTION (camera-ray grid of
-# the trace sweep, default 1024), REPEATS (default 3; trace's timed passes in the kernels
+# the trace sweep, default 1024), TRACE_ACCELS (the structures of the trace sweep, default
+# bvh8), REPEATS (default 3; trace's timed passes in the kernels
 # sweep), SWEEPS (default "trace build render"; add kernels).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,6 +25,7 @@ OUT=${OUT:-target/scaling}
 THREADS=${THREADS:-"1 2 4 8 16"}
 MESHES=${MESHES:-"bunny dragon202k dragon871k"}
 RESOLUTION=${RESOLUTION:-1024}
+TRACE_ACCELS=${TRACE_ACCELS:-bvh8}
 REPEATS=${REPEATS:-3}
 SWEEPS=${SWEEPS:-"trace build render"}
 if [ -z "${RAYLAB:-}" ]; then
@@ -45,7 +47,7 @@ for sweep in $SWEEPS; do
           [ -e "$p" ] || { echo "$p: not found (set RAYLAB_SHARED to the shared scenes folder)" >&2; exit 1; }
           echo "== $sweep, $m, $t thread(s)"
           if [ "$sweep" = trace ]; then
-            "$RAYLAB" bench "$p" --accels bvh8 --peers embree --threads "$t" --repeats "$REPEATS" --resolution "$RESOLUTION" --json-out "$OUT/trace-$m-t$t.json" > "$OUT/trace-$m-t$t.md" 2>&1 || echo "FAILED: trace $m $t" | tee -a "$OUT/failed.txt"
+            "$RAYLAB" bench "$p" --accels "$TRACE_ACCELS" --peers embree --threads "$t" --repeats "$REPEATS" --resolution "$RESOLUTION" --json-out "$OUT/trace-$m-t$t.json" > "$OUT/trace-$m-t$t.md" 2>&1 || echo "FAILED: trace $m $t" | tee -a "$OUT/failed.txt"
           else
             "$RAYLAB" bench "$p" --accels bvh,sbvh,lbvh,lbvh-ploc,bvh8 --peers embree --rays primary --threads "$t" --repeats "$REPEATS" --resolution 32 --json-out "$OUT/build-$m-t$t.json" > "$OUT/build-$m-t$t.md" 2>&1 || echo "FAILED: build $m $t" | tee -a "$OUT/failed.txt"
           fi
