@@ -133,7 +133,10 @@ pub(super) fn build<P: Primitives + ?Sized>(prims: &P, method: SplitMethod, opts
         .collect();
     let ctx = Ctx { method, sah: SahCost::from_options(opts), max_leaf: opts.max_leaf_size.max(1), bins: opts.bins.clamp(2, 256), block: opts.leaf_block.max(1) };
     let extent = Extent::of(&refs);
-    let root = ctx.build(&mut refs, extent, 0, 1, &mut Scratch::new(ctx.bins));
+    // The partitions' working copy of the top of the tree, allocated (and its pages touched,
+    // in parallel) once rather than grown and faulted in at every large node.
+    let mut spare: Vec<PrimRef> = if n >= PARALLEL_THRESHOLD { refs.par_iter().copied().collect() } else { Vec::new() };
+    let root = ctx.build(&mut refs, &mut spare, extent, 0, 1, &mut Scratch::new(ctx.bins));
     let mut nodes: Vec<BvhNode> = (0..1 + root.descendants()).into_par_iter().map(|_| BvhNode::interior(Aabb::EMPTY, 0)).collect();
     let (top, below) = nodes.split_at_mut(1);
     top[0] = flatten(root, 1, below);
@@ -177,20 +180,29 @@ struct Scratch {
     /// Per plane, the right side's primitives and its area times their test count.
     right_count: Vec<usize>,
     right_cost: Vec<f32>,
-    /// The right side of a serial partition, on its way to the back.
-    rights: Vec<PrimRef>,
+    /// The partitions' working copy below [`PARALLEL_THRESHOLD`] (see [`partition`]).
+    spare: Vec<PrimRef>,
 }
 
 impl Scratch {
+    /// A working copy for partitioning `refs`: the scratch's own, grown to fit.
+    fn spare_for(&mut self, refs: &[PrimRef]) -> &mut [PrimRef] {
+        if self.spare.len() < refs.len() {
+            self.spare.resize(refs.len(), refs[0]);
+        }
+        &mut self.spare[..refs.len()]
+    }
+
     fn new(nb: usize) -> Self {
-        Self { bins: Bins::new(nb), right_count: vec![0; nb], right_cost: vec![0.0; nb], rights: Vec::new() }
+        Self { bins: Bins::new(nb), right_count: vec![0; nb], right_cost: vec![0.0; nb], spare: Vec::new() }
     }
 }
 
 impl Ctx {
     /// Builds the subtree over `refs` (bounded by `extent`), whose first element sits at
-    /// `offset` in the final primitive order.
-    fn build(&self, refs: &mut [PrimRef], extent: Extent, offset: usize, depth: usize, scratch: &mut Scratch) -> BuildNode {
+    /// `offset` in the final primitive order; `spare` is as long as `refs`, the partitions'
+    /// working copy.
+    fn build(&self, refs: &mut [PrimRef], spare: &mut [PrimRef], extent: Extent, offset: usize, depth: usize, scratch: &mut Scratch) -> BuildNode {
         if refs.len() < PARALLEL_THRESHOLD {
             let mut nodes = Vec::with_capacity(refs.len());
             nodes.push(BvhNode::interior(Aabb::EMPTY, 0));
@@ -202,9 +214,10 @@ impl Ctx {
         if refs.len() <= 1 || depth >= MAX_DEPTH {
             return leaf;
         }
-        let Some((mid, le, re)) = self.split(refs, &extent, scratch) else { return leaf };
+        let Some((mid, le, re)) = self.split(refs, &extent, scratch, Some(&mut *spare)) else { return leaf };
         let (l, r) = refs.split_at_mut(mid);
-        let (left, right) = rayon::join(|| self.build(l, le, offset, depth + 1, scratch), || self.build(r, re, offset + mid, depth + 1, &mut Scratch::new(self.bins)));
+        let (l_spare, r_spare) = spare.split_at_mut(mid);
+        let (left, right) = rayon::join(|| self.build(l, l_spare, le, offset, depth + 1, scratch), || self.build(r, r_spare, re, offset + mid, depth + 1, &mut Scratch::new(self.bins)));
         let descendants = 2 + left.descendants() + right.descendants();
         BuildNode::Interior { bounds, children: Box::new([left, right]), descendants }
     }
@@ -215,7 +228,7 @@ impl Ctx {
     #[allow(clippy::too_many_arguments)]
     fn build_flat(&self, refs: &mut [PrimRef], extent: Extent, offset: usize, depth: usize, scratch: &mut Scratch, nodes: &mut Vec<BvhNode>, at: usize) {
         let bounds = extent.geom.aabb();
-        let split = if refs.len() <= 1 || depth >= MAX_DEPTH { None } else { self.split(refs, &extent, scratch) };
+        let split = if refs.len() <= 1 || depth >= MAX_DEPTH { None } else { self.split(refs, &extent, scratch, None) };
         let Some((mid, le, re)) = split else {
             nodes[at] = BvhNode::leaf(bounds, offset as u32, refs.len() as u32);
             return;
@@ -228,8 +241,9 @@ impl Ctx {
         self.build_flat(r, re, offset + mid, depth + 1, scratch, nodes, pair + 1);
     }
 
-    /// Partitions `refs`, or `None` for a leaf.
-    fn split(&self, refs: &mut [PrimRef], extent: &Extent, scratch: &mut Scratch) -> Option<Split> {
+    /// Partitions `refs`, or `None` for a leaf. `spare`: a working copy as long as `refs`,
+    /// else the scratch's.
+    fn split(&self, refs: &mut [PrimRef], extent: &Extent, scratch: &mut Scratch, spare: Option<&mut [PrimRef]>) -> Option<Split> {
         let cb = extent.cent.aabb();
         let axis = cb.max_axis();
         if cb.max[axis] - cb.min[axis] <= 0.0 {
@@ -238,14 +252,14 @@ impl Ctx {
             return (refs.len() > self.max_leaf).then(|| halves(refs, refs.len() / 2));
         }
         match self.method {
-            SplitMethod::BinnedSah => self.split_sah(refs, extent, scratch),
+            SplitMethod::BinnedSah => self.split_sah(refs, extent, scratch, spare),
             SplitMethod::Median => (refs.len() > self.max_leaf).then(|| split_median(refs, axis)),
             SplitMethod::Midpoint => {
                 if refs.len() <= self.max_leaf {
                     return None;
                 }
                 let mid = 0.5 * (cb.min[axis] + cb.max[axis]);
-                let split = partition(refs, |r| r.centroid()[axis] < mid, &mut scratch.rights);
+                let split = partition(refs, |r| r.centroid()[axis] < mid, spare.unwrap_or_else(|| scratch.spare_for(refs)));
                 Some(if split.0 == 0 || split.0 == refs.len() { split_median(refs, axis) } else { split })
             }
         }
@@ -254,7 +268,7 @@ impl Ctx {
     /// Binned SAH over all three axes (Wald 2007, "On fast Construction of SAH-based
     /// Bounding Volume Hierarchies"): centroids fall into `bins` equal bins per axis; the
     /// `bins - 1` planes between bins are evaluated by a prefix/suffix sweep.
-    fn split_sah(&self, refs: &mut [PrimRef], extent: &Extent, scratch: &mut Scratch) -> Option<Split> {
+    fn split_sah(&self, refs: &mut [PrimRef], extent: &Extent, scratch: &mut Scratch, spare: Option<&mut [PrimRef]>) -> Option<Split> {
         // Fewer bins for small nodes, as Embree does (4 + n/20, at most `bins`): most nodes
         // are small, and there clearing and sweeping the bins cost more than binning.
         let nb = self.bins.min(4 + refs.len() / 20);
@@ -315,7 +329,7 @@ impl Ctx {
         // whole number at most `nb - 1`, and a NaN falls in bin 0, on the left.
         let (lo, s, plane_f) = (cb.min[axis], scale[axis], plane as f32);
         #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x >= p)`, not `x < p`: a NaN goes left.
-        let split = partition(refs, |r| !((r.centroid()[axis] - lo) * s >= plane_f), &mut scratch.rights);
+        let split = partition(refs, |r| !((r.centroid()[axis] - lo) * s >= plane_f), spare.unwrap_or_else(|| scratch.spare_for(refs)));
         debug_assert!(split.0 > 0 && split.0 < refs.len());
         Some(split)
     }
@@ -405,25 +419,26 @@ impl Bins {
 }
 
 /// Moves the primitives for which `left` holds to the front, both sides in their input
-/// order (a stable partition); returns their number and both sides' extents. Nodes of
-/// [`PARALLEL_BINNING`] primitives or more (the top of the tree, where few subtrees run
-/// side by side) partition in parallel when there are [`PARALLEL_PARTITION_THREADS`]
-/// threads: the parallel partition makes three passes over memory to the serial one's one,
-/// and pays off only then. Both give the same order, so the tree does not depend on it.
-fn partition(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool + Sync, rights: &mut Vec<PrimRef>) -> Split {
+/// order (a stable partition); returns their number and both sides' extents. `spare` (as
+/// long as `refs`) is working memory. Nodes of [`PARALLEL_BINNING`] primitives or more (the
+/// top of the tree, where few subtrees run side by side) partition in parallel when there
+/// are [`PARALLEL_PARTITION_THREADS`] threads: the parallel partition makes three passes
+/// over memory to the serial one's one, and pays off only then. Both give the same order,
+/// so the tree does not depend on it.
+fn partition(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool + Sync, spare: &mut [PrimRef]) -> Split {
+    debug_assert_eq!(refs.len(), spare.len());
     if refs.len() >= PARALLEL_BINNING && rayon::current_num_threads() >= PARALLEL_PARTITION_THREADS {
-        partition_parallel(refs, left)
+        partition_parallel(refs, left, spare)
     } else {
-        partition_serial(refs, left, rights)
+        partition_serial(refs, left, spare)
     }
 }
 
 /// One sweep: the left primitives move forward in place (a write never passes the read),
 /// the right ones wait in `rights` and follow.
-fn partition_serial(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool, rights: &mut Vec<PrimRef>) -> Split {
+fn partition_serial(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool, rights: &mut [PrimRef]) -> Split {
     let (mut le, mut re) = (Extent::EMPTY, Extent::EMPTY);
-    rights.clear();
-    let mut m = 0;
+    let (mut m, mut j) = (0, 0);
     for k in 0..refs.len() {
         let r = refs[k];
         if left(&r) {
@@ -432,18 +447,19 @@ fn partition_serial(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool, right
             m += 1;
         } else {
             re.add(&r);
-            rights.push(r);
+            rights[j] = r;
+            j += 1;
         }
     }
-    refs[m..].copy_from_slice(rights);
+    refs[m..].copy_from_slice(&rights[..j]);
     (m, le, re)
 }
 
 /// A stable partition in chunks of [`BIN_CHUNK`]: each chunk counts and bounds its two
 /// sides, prefix sums of the counts give each chunk its place on either side, and the
-/// chunks then copy their primitives there from a copy of the input, side by side. Both
-/// sides keep the input order, so the result does not depend on the thread count.
-fn partition_parallel(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool + Sync) -> Split {
+/// chunks then copy their primitives there from a copy of the input (in `spare`), side by
+/// side. Both sides keep the input order, so the result does not depend on the thread count.
+fn partition_parallel(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool + Sync, spare: &mut [PrimRef]) -> Split {
     let sides: Vec<(usize, Extent, Extent)> = refs
         .par_chunks(BIN_CHUNK)
         .map(|chunk| {
@@ -460,7 +476,8 @@ fn partition_parallel(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool + Sy
         })
         .collect();
     let (m, le, re) = sides.iter().fold((0, Extent::EMPTY, Extent::EMPTY), |(m, le, re), &(cm, cl, cr)| (m + cm, le.merge(cl), re.merge(cr)));
-    let input: Vec<PrimRef> = refs.par_iter().copied().collect();
+    spare.par_chunks_mut(BIN_CHUNK).zip(refs.par_chunks(BIN_CHUNK)).for_each(|(to, from)| to.copy_from_slice(from));
+    let input = &*spare;
     let (mut lefts, mut rights) = refs.split_at_mut(m);
     let mut places = Vec::with_capacity(sides.len());
     for (chunk, &(cm, _, _)) in input.chunks(BIN_CHUNK).zip(&sides) {
@@ -541,9 +558,9 @@ mod tests {
         for cut in [-1.0, 30.0, 50.0, 101.0] {
             let left = |r: &PrimRef| r.centroid().x < cut;
             let mut refs = input.clone();
-            let (m, le, re) = partition_parallel(&mut refs, left);
+            let (m, le, re) = partition_parallel(&mut refs, left, &mut input.clone());
             let mut serial = input.clone();
-            let (ms, les, res) = partition_serial(&mut serial, left, &mut Vec::new());
+            let (ms, les, res) = partition_serial(&mut serial, left, &mut input.clone());
             assert!(serial.iter().map(PrimRef::id).eq(refs.iter().map(PrimRef::id)) && ms == m, "cut {cut}: the serial partition's order");
             assert!(extents_equal(&les, &le) && extents_equal(&res, &re));
             let want: Vec<u32> = input.iter().filter(|r| left(r)).chain(input.iter().filter(|r| !left(r))).map(PrimRef::id).collect();
