@@ -127,7 +127,7 @@ fn collapse_forking<P: Primitives + ?Sized, const W: usize>(bvh: &Bvh, prims: &P
     // were a third of the collapse's time at 16 threads.
     let mut nodes: Vec<WideNode<W>> = (0..size.nodes).into_par_iter().map(|_| WideNode::EMPTY_NODE).collect();
     let mut blocks: Vec<TriBlock> = (0..size.blocks).into_par_iter().map(|_| TriBlock::EMPTY_BLOCK).collect();
-    let root = ctx.child(0, Part { nodes: &mut nodes, blocks: &mut blocks, node_base: 0, block_base: 0 });
+    let root = ctx.child(0, Part { nodes: &mut nodes, blocks: &mut blocks, node_base: 0, block_base: 0 }, &mut Vec::new());
     Collapsed { nodes, blocks, root, root_bounds: bin[0].bounds() }
 }
 
@@ -242,43 +242,54 @@ impl<P: Primitives + ?Sized, const W: usize> Ctx<'_, P, W> {
     /// Emits binary node `i`, whole (a leaf or a wide node, as planned), into `out`, which
     /// is exactly its planned size; returns its reference. The layout is depth first: a
     /// wide node, then its lanes' subtrees in lane order, blocks in the same order.
-    fn child(&self, i: usize, mut out: Part<'_, W>) -> ChildRef {
+    /// `refs`: working memory for the leaves' references, reused from leaf to leaf (an
+    /// allocation per leaf was a tenth of the collapse).
+    fn child(&self, i: usize, mut out: Part<'_, W>, refs: &mut Vec<u32>) -> ChildRef {
         let n = &self.bin[i];
         if n.is_leaf() || self.plan[i].leaf {
-            let mut refs = Vec::with_capacity(self.plan[i].refs);
-            gather(self.bin, self.indices, i, &mut refs);
+            refs.clear();
+            gather(self.bin, self.indices, i, refs);
             // Spatial splits may put one primitive in two leaves of a merged subtree.
             refs.sort_unstable();
             refs.dedup();
-            return self.leaf(&refs, n.bounds(), out);
+            return self.leaf(refs, n.bounds(), out);
         }
         let l = n.left_first as usize;
         let k = self.plan[i].wide as usize;
-        let mut open = Vec::with_capacity(W);
-        self.slots(l, k, &mut open);
-        self.slots(l + 1, W - k, &mut open);
+        let (mut open, mut len) = ([0; W], 0);
+        self.slots(l, k, &mut open, &mut len);
+        self.slots(l + 1, W - k, &mut open, &mut len);
+        let open = &open[..len];
         let node = out.take(Size { nodes: 1, blocks: 0 });
-        let lanes: Vec<(usize, Part<'_, W>)> = open.iter().map(|&c| (c, out.take(self.plan[c].size))).collect();
-        assert!(out.nodes.is_empty() && out.blocks.is_empty(), "the plan sized the subtree");
-        let refs: Vec<ChildRef> = if self.plan[i].refs >= self.fork_refs {
-            lanes.into_par_iter().map(|(c, part)| self.child(c, part)).collect()
+        if self.plan[i].refs >= self.fork_refs {
+            let lanes: Vec<(usize, Part<'_, W>)> = open.iter().map(|&c| (c, out.take(self.plan[c].size))).collect();
+            assert!(out.nodes.is_empty() && out.blocks.is_empty(), "the plan sized the subtree");
+            let refs: Vec<ChildRef> = lanes.into_par_iter().map(|(c, part)| self.child(c, part, &mut Vec::new())).collect();
+            for (lane, (&c, r)) in open.iter().zip(refs).enumerate() {
+                node.nodes[0].set(lane, &self.bin[c].bounds(), r);
+            }
         } else {
-            lanes.into_iter().map(|(c, part)| self.child(c, part)).collect()
-        };
-        for (lane, (&c, r)) in open.iter().zip(refs).enumerate() {
-            node.nodes[0].set(lane, &self.bin[c].bounds(), r);
+            for (lane, &c) in open.iter().enumerate() {
+                let r = self.child(c, out.take(self.plan[c].size), refs);
+                node.nodes[0].set(lane, &self.bin[c].bounds(), r);
+            }
+            assert!(out.nodes.is_empty() && out.blocks.is_empty(), "the plan sized the subtree");
         }
         node.node_base as ChildRef
     }
 
-    /// The binary nodes that subtree `i` puts in at most `j` slots of its parent.
-    fn slots(&self, i: usize, j: usize, out: &mut Vec<usize>) {
+    /// The binary nodes that subtree `i` puts in at most `j` slots of its parent, appended
+    /// to the first `len` of `out`.
+    fn slots(&self, i: usize, j: usize, out: &mut [usize; W], len: &mut usize) {
         match self.plan[i].split[j - 1] {
-            0 => out.push(i),
+            0 => {
+                out[*len] = i;
+                *len += 1;
+            }
             k => {
                 let l = self.bin[i].left_first as usize;
-                self.slots(l, k as usize, out);
-                self.slots(l + 1, j - k as usize, out);
+                self.slots(l, k as usize, out, len);
+                self.slots(l + 1, j - k as usize, out, len);
             }
         }
     }
