@@ -407,11 +407,12 @@ impl Bins {
         }
     }
 
+    /// Adds `o`'s bins to these (first sets only: the second is empty between calls).
     fn merge(mut self, o: Bins) -> Bins {
-        for (a, b) in self.bounds.iter_mut().zip(o.bounds) {
-            *a = a.union(b);
+        for (a, b) in self.bounds[..self.second].iter_mut().zip(&o.bounds[..o.second]) {
+            *a = a.union(*b);
         }
-        for (a, b) in self.count.iter_mut().zip(o.count) {
+        for (a, b) in self.count[..self.second].iter_mut().zip(&o.count[..o.second]) {
             *a += b;
         }
         self
