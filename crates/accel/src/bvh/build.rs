@@ -8,6 +8,11 @@
 //! splits partition (stably, in parallel at the top of the tree): binning and partitioning stream through memory instead of
 //! following an index into separate box and centroid arrays, and a partition hands each
 //! side its box and its centroids' box, so no node reads its primitives again to bound them.
+//!
+//! A partition writes each side to its place in a second array as long as the first, whose
+//! parts the children then use as their input, the first array's as their output (ping-pong):
+//! one read and one write per primitive and level, with no copy back. A leaf whose
+//! primitives end up in the second array copies them home.
 
 use glam::Vec3A;
 use rayon::prelude::*;
@@ -133,10 +138,10 @@ pub(super) fn build<P: Primitives + ?Sized>(prims: &P, method: SplitMethod, opts
         .collect();
     let ctx = Ctx { method, sah: SahCost::from_options(opts), max_leaf: opts.max_leaf_size.max(1), bins: opts.bins.clamp(2, 256), block: opts.leaf_block.max(1) };
     let extent = Extent::of(&refs);
-    // The partitions' working copy of the top of the tree, allocated (and its pages touched,
-    // in parallel) once rather than grown and faulted in at every large node.
-    let mut spare: Vec<PrimRef> = if n >= PARALLEL_THRESHOLD { refs.par_iter().copied().collect() } else { Vec::new() };
-    let root = ctx.build(&mut refs, &mut spare, extent, 0, 1, &mut Scratch::new(ctx.bins));
+    // The partitions' second array, allocated (and its pages touched, in parallel) once
+    // rather than grown and faulted in at every large node.
+    let mut spare: Vec<PrimRef> = if n >= PARALLEL_THRESHOLD { refs.par_iter().copied().collect() } else { refs.clone() };
+    let root = ctx.build(Halves { refs: &mut refs, spare: &mut spare, home: true }, extent, 0, 1, &mut Scratch::new(ctx.bins));
     let mut nodes: Vec<BvhNode> = (0..1 + root.descendants()).into_par_iter().map(|_| BvhNode::interior(Aabb::EMPTY, 0)).collect();
     let (top, below) = nodes.split_at_mut(1);
     top[0] = flatten(root, 1, below);
@@ -180,44 +185,58 @@ struct Scratch {
     /// Per plane, the right side's primitives and its area times their test count.
     right_count: Vec<usize>,
     right_cost: Vec<f32>,
-    /// The partitions' working copy below [`PARALLEL_THRESHOLD`] (see [`partition`]).
-    spare: Vec<PrimRef>,
 }
 
 impl Scratch {
-    /// A working copy for partitioning `refs`: the scratch's own, grown to fit.
-    fn spare_for(&mut self, refs: &[PrimRef]) -> &mut [PrimRef] {
-        if self.spare.len() < refs.len() {
-            self.spare.resize(refs.len(), refs[0]);
+    fn new(nb: usize) -> Self {
+        Self { bins: Bins::new(nb), right_count: vec![0; nb], right_cost: vec![0.0; nb] }
+    }
+}
+
+/// A subtree's primitives (`refs`) and the same range of the other array (`spare`, as
+/// long): `home` when `refs` lies in the output array, which the leaves must fill.
+struct Halves<'a> {
+    refs: &'a mut [PrimRef],
+    spare: &'a mut [PrimRef],
+    home: bool,
+}
+
+impl<'a> Halves<'a> {
+    /// A leaf: its primitives, copied into the output array when they lie in the other.
+    fn settle(self) {
+        if !self.home {
+            self.spare.copy_from_slice(self.refs);
         }
-        &mut self.spare[..refs.len()]
     }
 
-    fn new(nb: usize) -> Self {
-        Self { bins: Bins::new(nb), right_count: vec![0; nb], right_cost: vec![0.0; nb], spare: Vec::new() }
+    /// The two children's halves after a split of `mid` on the left that `moved` the
+    /// primitives into `spare` (or left them in `refs`).
+    fn children(self, mid: usize, moved: bool) -> (Halves<'a>, Halves<'a>) {
+        let (from, to, home) = if moved { (self.spare, self.refs, !self.home) } else { (self.refs, self.spare, self.home) };
+        let ((lf, rf), (lt, rt)) = (from.split_at_mut(mid), to.split_at_mut(mid));
+        (Halves { refs: lf, spare: lt, home }, Halves { refs: rf, spare: rt, home })
     }
 }
 
 impl Ctx {
-    /// Builds the subtree over `refs` (bounded by `extent`), whose first element sits at
-    /// `offset` in the final primitive order; `spare` is as long as `refs`, the partitions'
-    /// working copy.
-    fn build(&self, refs: &mut [PrimRef], spare: &mut [PrimRef], extent: Extent, offset: usize, depth: usize, scratch: &mut Scratch) -> BuildNode {
-        if refs.len() < PARALLEL_THRESHOLD {
-            let mut nodes = Vec::with_capacity(refs.len());
+    /// Builds the subtree over `h.refs` (bounded by `extent`), whose first element sits at
+    /// `offset` in the final primitive order.
+    fn build(&self, mut h: Halves, extent: Extent, offset: usize, depth: usize, scratch: &mut Scratch) -> BuildNode {
+        let n = h.refs.len();
+        if n < PARALLEL_THRESHOLD {
+            let mut nodes = Vec::with_capacity(n);
             nodes.push(BvhNode::interior(Aabb::EMPTY, 0));
-            self.build_flat(refs, extent, offset, depth, scratch, &mut nodes, 0);
+            self.build_flat(h, extent, offset, depth, scratch, &mut nodes, 0);
             return BuildNode::Flat(nodes);
         }
         let bounds = extent.geom.aabb();
-        let leaf = BuildNode::Leaf { bounds, first: offset as u32, count: refs.len() as u32 };
-        if refs.len() <= 1 || depth >= MAX_DEPTH {
-            return leaf;
-        }
-        let Some((mid, le, re)) = self.split(refs, &extent, scratch, Some(&mut *spare)) else { return leaf };
-        let (l, r) = refs.split_at_mut(mid);
-        let (l_spare, r_spare) = spare.split_at_mut(mid);
-        let (left, right) = rayon::join(|| self.build(l, l_spare, le, offset, depth + 1, scratch), || self.build(r, r_spare, re, offset + mid, depth + 1, &mut Scratch::new(self.bins)));
+        let split = if n <= 1 || depth >= MAX_DEPTH { None } else { self.split(&mut h, &extent, scratch) };
+        let Some(((mid, le, re), moved)) = split else {
+            h.settle();
+            return BuildNode::Leaf { bounds, first: offset as u32, count: n as u32 };
+        };
+        let (l, r) = h.children(mid, moved);
+        let (left, right) = rayon::join(|| self.build(l, le, offset, depth + 1, scratch), || self.build(r, re, offset + mid, depth + 1, &mut Scratch::new(self.bins)));
         let descendants = 2 + left.descendants() + right.descendants();
         BuildNode::Interior { bounds, children: Box::new([left, right]), descendants }
     }
@@ -226,41 +245,47 @@ impl Ctx {
     /// subtree as [`flatten`] lays it out: the two children side by side, then the left
     /// child's subtree, then the right's (tinybvh's order of allocation).
     #[allow(clippy::too_many_arguments)]
-    fn build_flat(&self, refs: &mut [PrimRef], extent: Extent, offset: usize, depth: usize, scratch: &mut Scratch, nodes: &mut Vec<BvhNode>, at: usize) {
-        let bounds = extent.geom.aabb();
-        let split = if refs.len() <= 1 || depth >= MAX_DEPTH { None } else { self.split(refs, &extent, scratch, None) };
-        let Some((mid, le, re)) = split else {
-            nodes[at] = BvhNode::leaf(bounds, offset as u32, refs.len() as u32);
+    fn build_flat(&self, mut h: Halves, extent: Extent, offset: usize, depth: usize, scratch: &mut Scratch, nodes: &mut Vec<BvhNode>, at: usize) {
+        let (bounds, n) = (extent.geom.aabb(), h.refs.len());
+        let split = if n <= 1 || depth >= MAX_DEPTH { None } else { self.split(&mut h, &extent, scratch) };
+        let Some(((mid, le, re), moved)) = split else {
+            h.settle();
+            nodes[at] = BvhNode::leaf(bounds, offset as u32, n as u32);
             return;
         };
         let pair = nodes.len();
         nodes.extend([BvhNode::interior(Aabb::EMPTY, 0); 2]);
         nodes[at] = BvhNode::interior(bounds, pair as u32);
-        let (l, r) = refs.split_at_mut(mid);
+        let (l, r) = h.children(mid, moved);
         self.build_flat(l, le, offset, depth + 1, scratch, nodes, pair);
         self.build_flat(r, re, offset + mid, depth + 1, scratch, nodes, pair + 1);
     }
 
-    /// Partitions `refs`, or `None` for a leaf. `spare`: a working copy as long as `refs`,
-    /// else the scratch's.
-    fn split(&self, refs: &mut [PrimRef], extent: &Extent, scratch: &mut Scratch, spare: Option<&mut [PrimRef]>) -> Option<Split> {
+    /// Splits `h.refs`, or `None` for a leaf; the flag says whether the primitives moved
+    /// to `h.spare` (a partition) or were reordered in place.
+    fn split(&self, h: &mut Halves, extent: &Extent, scratch: &mut Scratch) -> Option<(Split, bool)> {
+        let refs = &mut *h.refs;
         let cb = extent.cent.aabb();
         let axis = cb.max_axis();
         if cb.max[axis] - cb.min[axis] <= 0.0 {
             // All centroids coincide: no plane separates them. Split by index only when the
             // leaf would be too large, so leaves stay bounded.
-            return (refs.len() > self.max_leaf).then(|| halves(refs, refs.len() / 2));
+            return (refs.len() > self.max_leaf).then(|| (halves(refs, refs.len() / 2), false));
         }
         match self.method {
-            SplitMethod::BinnedSah => self.split_sah(refs, extent, scratch, spare),
-            SplitMethod::Median => (refs.len() > self.max_leaf).then(|| split_median(refs, axis)),
+            SplitMethod::BinnedSah => self.split_sah(h, extent, scratch).map(|s| (s, true)),
+            SplitMethod::Median => (refs.len() > self.max_leaf).then(|| (split_median(refs, axis), false)),
             SplitMethod::Midpoint => {
                 if refs.len() <= self.max_leaf {
                     return None;
                 }
                 let mid = 0.5 * (cb.min[axis] + cb.max[axis]);
-                let split = partition(refs, |r| r.centroid()[axis] < mid, spare.unwrap_or_else(|| scratch.spare_for(refs)));
-                Some(if split.0 == 0 || split.0 == refs.len() { split_median(refs, axis) } else { split })
+                let left = |r: &PrimRef| r.centroid()[axis] < mid;
+                let m = refs.iter().filter(|r| left(r)).count();
+                if m == 0 || m == refs.len() {
+                    return Some((split_median(refs, axis), false));
+                }
+                Some((partition(refs, h.spare, m, left), true))
             }
         }
     }
@@ -268,7 +293,8 @@ impl Ctx {
     /// Binned SAH over all three axes (Wald 2007, "On fast Construction of SAH-based
     /// Bounding Volume Hierarchies"): centroids fall into `bins` equal bins per axis; the
     /// `bins - 1` planes between bins are evaluated by a prefix/suffix sweep.
-    fn split_sah(&self, refs: &mut [PrimRef], extent: &Extent, scratch: &mut Scratch, spare: Option<&mut [PrimRef]>) -> Option<Split> {
+    fn split_sah(&self, h: &mut Halves, extent: &Extent, scratch: &mut Scratch) -> Option<Split> {
+        let refs = &*h.refs;
         // Fewer bins for small nodes, as Embree does (4 + n/20, at most `bins`): most nodes
         // are small, and there clearing and sweeping the bins cost more than binning.
         let nb = self.bins.min(4 + refs.len() / 20);
@@ -293,8 +319,9 @@ impl Ctx {
         let pa = extent.geom.half_area();
         let flat = pa <= 0.0;
         let weight = |b: &Box3| if flat { 1.0 } else { b.half_area() };
-        // The cheapest plane so far: (x, axis, plane); `axis == 3` while there is none.
-        let (mut best_x, mut best_axis, mut best_plane) = (f32::INFINITY, 3, 0);
+        // The cheapest plane so far: (x, axis, plane, primitives on its left); `axis == 3`
+        // while there is none.
+        let (mut best_x, mut best_axis, mut best_plane, mut best_left) = (f32::INFINITY, 3, 0, 0);
         for axis in 0..3 {
             if scale[axis] == 0.0 {
                 continue;
@@ -316,7 +343,7 @@ impl Ctx {
                 }
                 let x = weight(&acc) * self.blocks(cnt) + right_cost[p];
                 if best_axis == 3 || x < best_x {
-                    (best_x, best_axis, best_plane) = (x, axis, p);
+                    (best_x, best_axis, best_plane, best_left) = (x, axis, p, cnt);
                 }
             }
         }
@@ -326,10 +353,11 @@ impl Ctx {
             return None;
         }
         // Bin `⌊clamp((c - lo) · s, 0, nb - 1)⌋ < plane` as one comparison: the plane is a
-        // whole number at most `nb - 1`, and a NaN falls in bin 0, on the left.
+        // whole number at most `nb - 1`, and a NaN falls in bin 0, on the left. It is the
+        // binning's arithmetic, so exactly the `best_left` primitives binned left go left.
         let (lo, s, plane_f) = (cb.min[axis], scale[axis], plane as f32);
         #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x >= p)`, not `x < p`: a NaN goes left.
-        let split = partition(refs, |r| !((r.centroid()[axis] - lo) * s >= plane_f), spare.unwrap_or_else(|| scratch.spare_for(refs)));
+        let split = partition(refs, h.spare, best_left, |r| !((r.centroid()[axis] - lo) * s >= plane_f));
         debug_assert!(split.0 > 0 && split.0 < refs.len());
         Some(split)
     }
@@ -419,86 +447,80 @@ impl Bins {
     }
 }
 
-/// Moves the primitives for which `left` holds to the front, both sides in their input
-/// order (a stable partition); returns their number and both sides' extents. `spare` (as
-/// long as `refs`) is working memory. Nodes of [`PARALLEL_BINNING`] primitives or more (the
-/// top of the tree, where few subtrees run side by side) partition in parallel when there
-/// are [`PARALLEL_PARTITION_THREADS`] threads: the parallel partition makes three passes
-/// over memory to the serial one's one, and pays off only then. Both give the same order,
-/// so the tree does not depend on it.
-fn partition(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool + Sync, spare: &mut [PrimRef]) -> Split {
-    debug_assert_eq!(refs.len(), spare.len());
-    if refs.len() >= PARALLEL_BINNING && rayon::current_num_threads() >= PARALLEL_PARTITION_THREADS {
-        partition_parallel(refs, left, spare)
+/// Writes the `m` primitives of `src` for which `left` holds to the front of `dst` and the
+/// others behind them, both sides in their input order (a stable partition); returns `m`
+/// and both sides' extents. Nodes of [`PARALLEL_BINNING`] primitives or more (the top of
+/// the tree, where few subtrees run side by side) partition in parallel when there are
+/// [`PARALLEL_PARTITION_THREADS`] threads: the parallel partition makes two passes over
+/// memory to the serial one's one, and pays off only then. Both give the same order, so
+/// the tree does not depend on it.
+///
+/// # Panics
+/// When `left` holds for other than `m` primitives (the caller counted them).
+fn partition(src: &[PrimRef], dst: &mut [PrimRef], m: usize, left: impl Fn(&PrimRef) -> bool + Sync) -> Split {
+    debug_assert_eq!(src.len(), dst.len());
+    if src.len() >= PARALLEL_BINNING && rayon::current_num_threads() >= PARALLEL_PARTITION_THREADS {
+        partition_parallel(src, dst, m, left)
     } else {
-        partition_serial(refs, left, spare)
+        partition_serial(src, dst, m, left)
     }
 }
 
-/// One sweep: the left primitives move forward in place (a write never passes the read),
-/// the right ones wait in `rights` and follow.
-fn partition_serial(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool, rights: &mut [PrimRef]) -> Split {
+/// One sweep, each primitive read once and written once.
+fn partition_serial(src: &[PrimRef], dst: &mut [PrimRef], m: usize, left: impl Fn(&PrimRef) -> bool) -> Split {
+    let (lefts, rights) = dst.split_at_mut(m);
     let (mut le, mut re) = (Extent::EMPTY, Extent::EMPTY);
-    let (mut m, mut j) = (0, 0);
-    for k in 0..refs.len() {
-        let r = refs[k];
-        if left(&r) {
-            le.add(&r);
-            refs[m] = r;
-            m += 1;
+    let (mut i, mut j) = (0, 0);
+    for r in src {
+        if left(r) {
+            le.add(r);
+            lefts[i] = *r;
+            i += 1;
         } else {
-            re.add(&r);
-            rights[j] = r;
+            re.add(r);
+            rights[j] = *r;
             j += 1;
         }
     }
-    refs[m..].copy_from_slice(&rights[..j]);
+    assert_eq!(i, m, "partition: the left side's count");
     (m, le, re)
 }
 
-/// A stable partition in chunks of [`BIN_CHUNK`]: each chunk counts and bounds its two
-/// sides, prefix sums of the counts give each chunk its place on either side, and the
-/// chunks then copy their primitives there from a copy of the input (in `spare`), side by
-/// side. Both sides keep the input order, so the result does not depend on the thread count.
-fn partition_parallel(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool + Sync, spare: &mut [PrimRef]) -> Split {
-    let sides: Vec<(usize, Extent, Extent)> = refs
-        .par_chunks(BIN_CHUNK)
-        .map(|chunk| {
-            let (mut m, mut le, mut re) = (0, Extent::EMPTY, Extent::EMPTY);
-            for r in chunk {
-                if left(r) {
-                    le.add(r);
-                    m += 1;
-                } else {
-                    re.add(r);
-                }
-            }
-            (m, le, re)
-        })
-        .collect();
-    let (m, le, re) = sides.iter().fold((0, Extent::EMPTY, Extent::EMPTY), |(m, le, re), &(cm, cl, cr)| (m + cm, le.merge(cl), re.merge(cr)));
-    spare.par_chunks_mut(BIN_CHUNK).zip(refs.par_chunks(BIN_CHUNK)).for_each(|(to, from)| to.copy_from_slice(from));
-    let input = &*spare;
-    let (mut lefts, mut rights) = refs.split_at_mut(m);
-    let mut places = Vec::with_capacity(sides.len());
-    for (chunk, &(cm, _, _)) in input.chunks(BIN_CHUNK).zip(&sides) {
+/// A stable partition in chunks of [`BIN_CHUNK`]: each chunk counts its left side, prefix
+/// sums of the counts give each chunk its place on either side, and the chunks then write
+/// their primitives there side by side, bounding both sides. Both sides keep the input
+/// order, so the result does not depend on the thread count.
+fn partition_parallel(src: &[PrimRef], dst: &mut [PrimRef], m: usize, left: impl Fn(&PrimRef) -> bool + Sync) -> Split {
+    let counts: Vec<usize> = src.par_chunks(BIN_CHUNK).map(|chunk| chunk.iter().filter(|r| left(r)).count()).collect();
+    assert_eq!(counts.iter().sum::<usize>(), m, "partition: the left side's count");
+    let (mut lefts, mut rights) = dst.split_at_mut(m);
+    let mut places = Vec::with_capacity(counts.len());
+    for (chunk, &cm) in src.chunks(BIN_CHUNK).zip(&counts) {
         let (l, l_rest) = std::mem::take(&mut lefts).split_at_mut(cm);
         let (r, r_rest) = std::mem::take(&mut rights).split_at_mut(chunk.len() - cm);
         places.push((l, r));
         (lefts, rights) = (l_rest, r_rest);
     }
-    input.par_chunks(BIN_CHUNK).zip(places).for_each(|(chunk, (l, r))| {
-        let (mut i, mut j) = (0, 0);
-        for p in chunk {
-            if left(p) {
-                l[i] = *p;
-                i += 1;
-            } else {
-                r[j] = *p;
-                j += 1;
+    let (le, re) = src
+        .par_chunks(BIN_CHUNK)
+        .zip(places)
+        .map(|(chunk, (l, r))| {
+            let (mut le, mut re) = (Extent::EMPTY, Extent::EMPTY);
+            let (mut i, mut j) = (0, 0);
+            for p in chunk {
+                if left(p) {
+                    le.add(p);
+                    l[i] = *p;
+                    i += 1;
+                } else {
+                    re.add(p);
+                    r[j] = *p;
+                    j += 1;
+                }
             }
-        }
-    });
+            (le, re)
+        })
+        .reduce(|| (Extent::EMPTY, Extent::EMPTY), |(a, b), (c, d)| (a.merge(c), b.merge(d)));
     (m, le, re)
 }
 
@@ -558,10 +580,11 @@ mod tests {
             .collect();
         for cut in [-1.0, 30.0, 50.0, 101.0] {
             let left = |r: &PrimRef| r.centroid().x < cut;
+            let count = input.iter().filter(|r| left(r)).count();
             let mut refs = input.clone();
-            let (m, le, re) = partition_parallel(&mut refs, left, &mut input.clone());
+            let (m, le, re) = partition_parallel(&input, &mut refs, count, left);
             let mut serial = input.clone();
-            let (ms, les, res) = partition_serial(&mut serial, left, &mut input.clone());
+            let (ms, les, res) = partition_serial(&input, &mut serial, count, left);
             assert!(serial.iter().map(PrimRef::id).eq(refs.iter().map(PrimRef::id)) && ms == m, "cut {cut}: the serial partition's order");
             assert!(extents_equal(&les, &le) && extents_equal(&res, &re));
             let want: Vec<u32> = input.iter().filter(|r| left(r)).chain(input.iter().filter(|r| !left(r))).map(PrimRef::id).collect();
