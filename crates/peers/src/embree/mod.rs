@@ -1,5 +1,5 @@
 //! Intel Embree 3 (Debian's `libembree-dev`) through the hand-written FFI of [`ffi`]: one
-//! device per structure configured with `threads=N`, one triangle-mesh geometry with an
+//! device per structure configured with `threads=N` (and what `RAYLAB_EMBREE_CONFIG` adds), one triangle-mesh geometry with an
 //! indexed vertex buffer (shared vertices merged, as an application hands Embree a mesh),
 //! the scene built at quality HIGH (spatial splits) or MEDIUM. Rays are traced with
 //! `rtcIntersect1` / `rtcOccluded1` from raylab's rayon workers, and primary packets with
@@ -76,7 +76,10 @@ impl EmbreePeer {
     /// the commit (merging the soup's vertices is raylab's side and is not counted).
     pub fn build(tris: &[[Vec3; 3]], threads: usize, quality: Quality) -> Result<Self, PeerError> {
         let (vertices, indices) = indexed(tris);
-        let config = CString::new(format!("threads={threads}")).unwrap();
+        // `RAYLAB_EMBREE_CONFIG` adds to the device's configuration: `verbose=2` prints
+        // Embree's own statistics of each build (SAH cost, nodes, fill) and its kernels.
+        let extra = std::env::var("RAYLAB_EMBREE_CONFIG").map(|c| format!(",{c}")).unwrap_or_default();
+        let config = CString::new(format!("threads={threads}{extra}")).map_err(|_| PeerError::Embree("RAYLAB_EMBREE_CONFIG holds a NUL byte".into()))?;
         // SAFETY: plain calls of Embree's C API on the objects created here, in the
         // documented order; buffers are written within the sizes Embree allocated.
         unsafe {
