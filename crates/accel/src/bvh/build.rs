@@ -469,20 +469,8 @@ fn partition(src: &[PrimRef], dst: &mut [PrimRef], m: usize, left: impl Fn(&Prim
 /// One sweep, each primitive read once and written once.
 fn partition_serial(src: &[PrimRef], dst: &mut [PrimRef], m: usize, left: impl Fn(&PrimRef) -> bool) -> Split {
     let (lefts, rights) = dst.split_at_mut(m);
-    let (mut le, mut re) = (Extent::EMPTY, Extent::EMPTY);
-    let (mut i, mut j) = (0, 0);
-    for r in src {
-        if left(r) {
-            le.add(r);
-            lefts[i] = *r;
-            i += 1;
-        } else {
-            re.add(r);
-            rights[j] = *r;
-            j += 1;
-        }
-    }
-    assert_eq!(i, m, "partition: the left side's count");
+    let (le, re, written) = scatter(src, lefts, rights, &left);
+    assert_eq!(written, m, "partition: the left side's count");
     (m, le, re)
 }
 
@@ -505,23 +493,32 @@ fn partition_parallel(src: &[PrimRef], dst: &mut [PrimRef], m: usize, left: impl
         .par_chunks(BIN_CHUNK)
         .zip(places)
         .map(|(chunk, (l, r))| {
-            let (mut le, mut re) = (Extent::EMPTY, Extent::EMPTY);
-            let (mut i, mut j) = (0, 0);
-            for p in chunk {
-                if left(p) {
-                    le.add(p);
-                    l[i] = *p;
-                    i += 1;
-                } else {
-                    re.add(p);
-                    r[j] = *p;
-                    j += 1;
-                }
-            }
+            let (le, re, _) = scatter(chunk, l, r, &left);
             (le, re)
         })
         .reduce(|| (Extent::EMPTY, Extent::EMPTY), |(a, b), (c, d)| (a.merge(c), b.merge(d)));
     (m, le, re)
+}
+
+/// Writes the primitives of `src` for which `left` holds to the front of `lefts` and the
+/// others to the front of `rights`, each side in input order; returns both sides' extents
+/// and the count written left. Panics when a side does not fit its slice.
+#[inline(always)]
+fn scatter(src: &[PrimRef], lefts: &mut [PrimRef], rights: &mut [PrimRef], left: &impl Fn(&PrimRef) -> bool) -> (Extent, Extent, usize) {
+    let (mut le, mut re) = (Extent::EMPTY, Extent::EMPTY);
+    let (mut i, mut j) = (0, 0);
+    for r in src {
+        if left(r) {
+            le.add(r);
+            lefts[i] = *r;
+            i += 1;
+        } else {
+            re.add(r);
+            rights[j] = *r;
+            j += 1;
+        }
+    }
+    (le, re, i)
 }
 
 #[cfg(test)]
