@@ -39,14 +39,15 @@ pub struct ShearedRay {
 impl ShearedRay {
     #[inline]
     pub fn new(ray: &Ray) -> Self {
-        let d = ray.dir;
-        let ad = d.abs();
-        let kz = if ad.x > ad.y { if ad.x > ad.z { 0 } else { 2 } } else if ad.y > ad.z { 1 } else { 2 };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
+        // Selections rather than branches (a ray's direction is as good as random) and
+        // indices into an array rather than into a `Vec3` (a chain of branches).
+        let d = ray.dir.to_array();
+        let ad = d.map(f32::abs);
+        // The axis of the largest |d|, ties to the later axis, as before.
+        let (m, xy) = if ad[0] > ad[1] { (ad[0], 0) } else { (ad[1], 1) };
+        let kz = if m > ad[2] { xy } else { 2 };
+        let (kx, ky) = ([1, 2, 0][kz], [2, 0, 1][kz]);
+        let (kx, ky) = if d[kz] < 0.0 { (ky, kx) } else { (kx, ky) };
         Self { origin: ray.origin, kx, ky, kz, sx: d[kx] / d[kz], sy: d[ky] / d[kz], sz: 1.0 / d[kz] }
     }
 

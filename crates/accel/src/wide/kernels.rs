@@ -52,10 +52,13 @@ impl RayBoxes {
     #[inline]
     pub fn new(ray: &Ray) -> Self {
         let inv = ray.inv_dir().to_array();
-        let near = [0, 1, 2].map(|a| if inv[a] < 0.0 { 3 + a } else { a });
-        let far = [0, 1, 2].map(|a| if inv[a] < 0.0 { a } else { 3 + a });
-        let t_min = if ray.t_min == 0.0 { 0.0 } else { ray.t_min };
-        let by_bits = t_min >= 0.0 && inv.iter().all(|i| i.is_finite());
+        // Written without branches: a ray's direction signs are as good as random.
+        let neg = inv.map(|i| usize::from(i < 0.0));
+        let near = [0, 1, 2].map(|a| a + 3 * neg[a]);
+        let far = [0, 1, 2].map(|a| a + 3 - 3 * neg[a]);
+        // `-0 + 0 = +0`; every other value is unchanged.
+        let t_min = ray.t_min + 0.0;
+        let by_bits = (t_min >= 0.0) & inv[0].is_finite() & inv[1].is_finite() & inv[2].is_finite();
         Self { origin: ray.origin.to_array(), inv, inv_far: inv.map(|i| i * ROBUST_FAR), near, far, t_min, by_bits }
     }
 }
@@ -288,6 +291,15 @@ impl BlockRay {
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 pub fn triangles_sse_for(b: &TriBlock, s: &BlockRay, t_min: f32, t_max: f32) -> BlockHits {
+    block_hits_sse(b, s, t_min, t_max).unwrap_or(BlockHits { hit: 0, exact: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] })
+}
+
+/// [`triangles_sse_for`], `None` when the edge functions alone reject every lane (most
+/// blocks a ray reaches): the traversal then leaves the block without writing its
+/// distances and barycentrics anywhere.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub fn block_hits_sse(b: &TriBlock, s: &BlockRay, t_min: f32, t_max: f32) -> Option<BlockHits> {
     use std::arch::x86_64::*;
     let [kx, ky, kz] = s.axes;
     // SAFETY: SSE2 is in the x86-64 baseline; every row holds 4 f32 and `prim` 4 u32.
@@ -320,7 +332,7 @@ pub fn triangles_sse_for(b: &TriBlock, s: &BlockRay, t_min: f32, t_max: f32) -> 
         // so, and the distance, its error bound and the division are skipped. (A lane that
         // is not a triangle is never skipped, whatever its vertices.)
         if (_mm_movemask_ps(_mm_andnot_ps(undecided_edges, outside)) as u32 & !other | empty) == 0xF {
-            return BlockHits { hit: 0, exact: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
+            return None;
         }
         let det = _mm_add_ps(_mm_add_ps(u, v), w);
         let (az, bz, cz) = (_mm_mul_ps(sz, az), _mm_mul_ps(sz, bz), _mm_mul_ps(sz, cz));
@@ -356,7 +368,7 @@ pub fn triangles_sse_for(b: &TriBlock, s: &BlockRay, t_min: f32, t_max: f32) -> 
         _mm_storeu_ps(out.t.as_mut_ptr(), t);
         _mm_storeu_ps(out.u.as_mut_ptr(), _mm_mul_ps(v, inv_det));
         _mm_storeu_ps(out.v.as_mut_ptr(), _mm_mul_ps(w, inv_det));
-        out
+        Some(out)
     }
 }
 

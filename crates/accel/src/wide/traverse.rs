@@ -72,7 +72,9 @@ pub(super) fn wins(t: f32, prim: u32, best: &Option<Hit>) -> bool {
 pub(super) fn block_closest<P: Primitives + ?Sized, const SIMD: bool>(b: &TriBlock, prims: &P, s: &ShearedRay, br: &BlockRay, ray: &mut Ray, best: &mut Option<Hit>) {
     #[cfg(target_arch = "x86_64")]
     if SIMD {
-        let h = super::kernels::triangles_sse_for(b, br, ray.t_min, ray.t_max);
+        let Some(h) = super::kernels::block_hits_sse(b, br, ray.t_min, ray.t_max) else {
+            return;
+        };
         let mut m = h.hit | h.exact;
         while m != 0 {
             let l = m.trailing_zeros() as usize;
@@ -104,7 +106,9 @@ pub(super) fn block_closest<P: Primitives + ?Sized, const SIMD: bool>(b: &TriBlo
 fn block_any<P: Primitives + ?Sized, const SIMD: bool>(b: &TriBlock, prims: &P, s: &ShearedRay, br: &BlockRay, ray: &Ray) -> bool {
     #[cfg(target_arch = "x86_64")]
     let mut m = if SIMD {
-        let h = super::kernels::triangles_sse_for(b, br, ray.t_min, ray.t_max);
+        let Some(h) = super::kernels::block_hits_sse(b, br, ray.t_min, ray.t_max) else {
+            return false;
+        };
         if h.hit != 0 {
             return true;
         }
