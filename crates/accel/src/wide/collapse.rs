@@ -11,7 +11,7 @@
 //! allocated once and subtrees are emitted in parallel straight into their parts of it.
 
 use rayon::prelude::*;
-use raylab_core::{Aabb, Vec3};
+use raylab_core::Aabb;
 
 use super::node::{leaf_ref, ChildRef, TriBlock, WideNode, EMPTY, MAX_BLOCKS, MAX_LEAF_BLOCKS};
 use crate::bvh::{Bvh, BvhNode};
@@ -40,9 +40,6 @@ struct Ctx<'a, P: ?Sized, const W: usize> {
     bin: &'a [BvhNode],
     indices: &'a [u32],
     prims: &'a P,
-    /// Each primitive's vertices (`None`: not a triangle), read in the mesh's order once:
-    /// leaves then fetch one record per triangle instead of four dependent loads.
-    triangles: Vec<Option<[Vec3; 3]>>,
     /// The dynamic programme's choices per binary node (see [`plan`]).
     plan: Vec<Plan<W>>,
     fork_refs: usize,
@@ -119,10 +116,10 @@ fn collapse_forking<P: Primitives + ?Sized, const W: usize>(bvh: &Bvh, prims: &P
     // Spatial splits may put one primitive in two leaves of a merged subtree, which then
     // holds it once: the plan counts such leaves' distinct references.
     let distinct = bvh.spatial_splits.then_some(&bvh.indices[..]);
-    let (plan, triangles) = rayon::join(|| plan::<W>(bin, distinct), || (0..prims.len() as u32).into_par_iter().map(|p| prims.triangle(p)).collect());
+    let plan = plan::<W>(bin, distinct);
     let size = plan[0].size;
     assert!(size.blocks <= MAX_BLOCKS, "wide BVH: too many triangle blocks");
-    let ctx = Ctx { bin, indices: &bvh.indices, prims, triangles, plan, fork_refs };
+    let ctx = Ctx { bin, indices: &bvh.indices, prims, plan, fork_refs };
     // Filled in parallel: tens of MiB written (and their pages faulted in) by one thread
     // were a third of the collapse's time at 16 threads.
     let mut nodes: Vec<WideNode<W>> = (0..size.nodes).into_par_iter().map(|_| WideNode::EMPTY_NODE).collect();
@@ -301,9 +298,11 @@ impl<P: Primitives + ?Sized, const W: usize> Ctx<'_, P, W> {
         let blocks = refs.len().div_ceil(4);
         if blocks <= MAX_LEAF_BLOCKS {
             assert!(out.nodes.is_empty() && out.blocks.len() == blocks, "the plan sized the leaf");
+            // Vertices come straight from the primitives: a copy of every triangle gathered
+            // beforehand (40 bytes each, on fresh pages) cost more than the loads it saved.
             for (b, chunk) in out.blocks.iter_mut().zip(refs.chunks(4)) {
                 for (lane, &p) in chunk.iter().enumerate() {
-                    match self.triangles[p as usize] {
+                    match self.prims.triangle(p) {
                         Some(v) => b.set_triangle(lane, p, v),
                         None => b.prim[lane] = p | TriBlock::OTHER,
                     }

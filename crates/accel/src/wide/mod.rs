@@ -103,7 +103,7 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
     pub fn from_binary<P: Primitives + ?Sized>(bvh: &Bvh, prims: &P, name: &'static str) -> Self {
         const { assert!(W == 4 || W == 8, "wide BVHs are 4 or 8 wide") };
         let c = collapse::collapse::<P, W>(bvh, prims);
-        let nodes: Vec<N> = encode(&c.nodes, c.root);
+        let nodes: Vec<N> = encode(c.nodes, c.root);
         // The root's decoded boxes may round past the scene's bounds: the root box holds them.
         let root_bounds = if c.root == EMPTY || is_leaf(c.root) { c.root_bounds } else { nodes[c.root as usize].with_decoded(|n| (0..W).filter(|&l| n.child[l] != EMPTY).fold(c.root_bounds, |b, l| b.union(n.child_bounds(l)))) };
         Self { nodes, blocks: c.blocks, root: c.root, root_bounds, name, build_ms: 0.0, primitives: prims.len(), spatial_splits: bvh.spatial_splits, kernel: Kernel::detect(W), packet_kernel: Kernel::detect_packets(W) }
@@ -239,8 +239,13 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
 /// the union of its child's decoded boxes: a layout that rounds boxes outward (quantised)
 /// then still nests every box in its parent's, which validation checks. For an exact
 /// layout (f32 boxes) the union is the lane's own box: the nodes convert one by one, in
-/// parallel.
-fn encode<const W: usize, N: Layout<W>>(nodes: &[WideNode<W>], root: ChildRef) -> Vec<N> {
+/// parallel, and the f32 layout takes the vector as it is (a copy of tens of MiB, and as
+/// many fresh pages, was a few per cent of a build).
+fn encode<const W: usize, N: Layout<W>>(nodes: Vec<WideNode<W>>, root: ChildRef) -> Vec<N> {
+    let nodes = match (Box::new(nodes) as Box<dyn std::any::Any>).downcast::<Vec<N>>() {
+        Ok(same) => return *same,
+        Err(other) => *other.downcast::<Vec<WideNode<W>>>().expect("the vector boxed above"),
+    };
     if N::EXACT {
         return nodes.par_iter().map(N::encode).collect();
     }
@@ -265,7 +270,7 @@ fn encode<const W: usize, N: Layout<W>>(nodes: &[WideNode<W>], root: ChildRef) -
         out[i] = Some(N::encode(&n));
     }
     // Nodes no traversal reaches (validation reports them) keep their own boxes.
-    out.into_iter().zip(nodes).map(|(e, n)| e.unwrap_or_else(|| N::encode(n))).collect()
+    out.into_iter().zip(&nodes).map(|(e, n)| e.unwrap_or_else(|| N::encode(n))).collect()
 }
 
 /// Whether this CPU runs the ray-major packet path ([`ray_major`]): AVX-512F and VL.
