@@ -49,8 +49,8 @@ struct Ctx<'a, P: ?Sized, const W: usize> {
 /// is emitted, so the output is allocated once and every subtree writes its own part of it.
 #[derive(Clone, Copy, Default, Debug, PartialEq)]
 struct Size {
-    nodes: usize,
-    blocks: usize,
+    nodes: u32,
+    blocks: u32,
 }
 
 impl std::ops::Add for Size {
@@ -65,7 +65,7 @@ impl std::ops::Add for Size {
 fn leaf_size<const W: usize>(refs: usize) -> Size {
     let blocks = refs.div_ceil(4);
     if blocks <= MAX_LEAF_BLOCKS {
-        return Size { nodes: 0, blocks };
+        return Size { nodes: 0, blocks: blocks as u32 };
     }
     let per = refs.div_ceil(W);
     let (full, rest) = (refs / per, refs % per);
@@ -91,12 +91,12 @@ struct Part<'o, const W: usize> {
 impl<'o, const W: usize> Part<'o, W> {
     /// Splits off the first `size` of this part for a subtree; `self` keeps the rest.
     fn take(&mut self, size: Size) -> Part<'o, W> {
-        let (nodes, rest_n) = std::mem::take(&mut self.nodes).split_at_mut(size.nodes);
-        let (blocks, rest_b) = std::mem::take(&mut self.blocks).split_at_mut(size.blocks);
+        let (nodes, rest_n) = std::mem::take(&mut self.nodes).split_at_mut(size.nodes as usize);
+        let (blocks, rest_b) = std::mem::take(&mut self.blocks).split_at_mut(size.blocks as usize);
         let head = Part { nodes, blocks, node_base: self.node_base, block_base: self.block_base };
         (self.nodes, self.blocks) = (rest_n, rest_b);
-        self.node_base += size.nodes;
-        self.block_base += size.blocks;
+        self.node_base += size.nodes as usize;
+        self.block_base += size.blocks as usize;
         head
     }
 }
@@ -118,12 +118,12 @@ fn collapse_forking<P: Primitives + ?Sized, const W: usize>(bvh: &Bvh, prims: &P
     let distinct = bvh.spatial_splits.then_some(&bvh.indices[..]);
     let plan = plan::<W>(bin, distinct);
     let size = plan[0].size;
-    assert!(size.blocks <= MAX_BLOCKS, "wide BVH: too many triangle blocks");
+    assert!(size.blocks as usize <= MAX_BLOCKS, "wide BVH: too many triangle blocks");
     let ctx = Ctx { bin, indices: &bvh.indices, prims, plan, fork_refs };
     // Filled in parallel: tens of MiB written (and their pages faulted in) by one thread
     // were a third of the collapse's time at 16 threads.
-    let mut nodes: Vec<WideNode<W>> = (0..size.nodes).into_par_iter().map(|_| WideNode::EMPTY_NODE).collect();
-    let mut blocks: Vec<TriBlock> = (0..size.blocks).into_par_iter().map(|_| TriBlock::EMPTY_BLOCK).collect();
+    let mut nodes: Vec<WideNode<W>> = (0..size.nodes as usize).into_par_iter().map(|_| WideNode::EMPTY_NODE).collect();
+    let mut blocks: Vec<TriBlock> = (0..size.blocks as usize).into_par_iter().map(|_| TriBlock::EMPTY_BLOCK).collect();
     let root = ctx.child(0, Part { nodes: &mut nodes, blocks: &mut blocks, node_base: 0, block_base: 0 }, &mut Vec::new());
     Collapsed { nodes, blocks, root, root_bounds: bin[0].bounds() }
 }
@@ -144,7 +144,7 @@ struct Plan<const W: usize> {
     #[cfg_attr(not(test), allow(dead_code))]
     cost: f32,
     /// References below the node.
-    refs: usize,
+    refs: u32,
     /// What the subtree emits, whole.
     size: Size,
 }
@@ -193,7 +193,7 @@ fn plan_subtree<const W: usize>(bin: &[BvhNode], distinct: Option<&[u32]>, i: us
         let as_leaf = area * refs.div_ceil(4) as f32;
         let size = leaf_size::<W>(distinct_refs(bin, distinct, i, refs));
         // SAFETY: each node is planned once, by the one task that holds its subtree.
-        unsafe { plan.write(i, Plan { leaf: true, split: [0; W], wide: 0, cost: as_leaf, refs, size }) };
+        unsafe { plan.write(i, Plan { leaf: true, split: [0; W], wide: 0, cost: as_leaf, refs: refs as u32, size }) };
         return (refs, [as_leaf; W], [size; W]);
     }
     let (l, r) = (n.left_first as usize, n.left_first as usize + 1);
@@ -219,7 +219,7 @@ fn plan_subtree<const W: usize>(bin: &[BvhNode], distinct: Option<&[u32]>, i: us
     let whole = if leaf { as_leaf } else { as_node };
     let wide = spread[W - 1].1 as usize;
     let size = if leaf { leaf_size::<W>(distinct_refs(bin, distinct, i, refs)) } else { Size { nodes: 1, blocks: 0 } + size_l[wide - 1] + size_r[W - wide - 1] };
-    let mut p = Plan { leaf, split: [0; W], wide: wide as u8, cost: whole, refs, size };
+    let mut p = Plan { leaf, split: [0; W], wide: wide as u8, cost: whole, refs: refs as u32, size };
     let mut cost = [whole; W];
     let mut sizes = [size; W];
     for j in 2..=W {
@@ -258,7 +258,7 @@ impl<P: Primitives + ?Sized, const W: usize> Ctx<'_, P, W> {
         self.slots(l + 1, W - k, &mut open, &mut len);
         let open = &open[..len];
         let node = out.take(Size { nodes: 1, blocks: 0 });
-        if self.plan[i].refs >= self.fork_refs {
+        if self.plan[i].refs as usize >= self.fork_refs {
             let lanes: Vec<(usize, Part<'_, W>)> = open.iter().map(|&c| (c, out.take(self.plan[c].size))).collect();
             assert!(out.nodes.is_empty() && out.blocks.is_empty(), "the plan sized the subtree");
             let refs: Vec<ChildRef> = lanes.into_par_iter().map(|(c, part)| self.child(c, part, &mut Vec::new())).collect();
