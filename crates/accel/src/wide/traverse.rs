@@ -191,6 +191,18 @@ pub(super) fn leaf_slice<const W: usize, N: Layout<W>>(bvh: &WideBvh<W, N>, r: C
     &bvh.blocks[first..first + n]
 }
 
+/// The portable walk of the rare rays the SIMD walk hands over, out of line so that it
+/// does not share the SIMD walk's function and registers.
+#[inline(never)]
+fn closest_portable<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
+    closest::<P, W, N, false, COUNT>(bvh, prims, ray, c)
+}
+
+#[inline(never)]
+fn any_portable<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
+    any::<P, W, N, false, COUNT>(bvh, prims, ray, c)
+}
+
 #[inline(always)]
 pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SIMD: bool, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
     // The per-ray constants are read from the caller's ray, not from the copy below: a
@@ -200,7 +212,7 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
         // Rays along an axis or reaching behind their origin (rare) take the portable
         // kernels, which answer as the SIMD ones do: the SIMD box tests are then compiled
         // for integer order alone, with no branch in the loop.
-        return closest::<P, W, N, false, COUNT>(bvh, prims, ray, c);
+        return closest_portable::<P, W, N, COUNT>(bvh, prims, ray, c);
     }
     if COUNT {
         c.rays += 1;
@@ -288,7 +300,7 @@ pub(super) fn any<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SI
     let rb = RayBoxes::new(ray);
     if SIMD && !rb.by_bits {
         // As in `closest`.
-        return any::<P, W, N, false, COUNT>(bvh, prims, ray, c);
+        return any_portable::<P, W, N, COUNT>(bvh, prims, ray, c);
     }
     if COUNT {
         c.rays += 1;
