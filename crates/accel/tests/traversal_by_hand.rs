@@ -976,6 +976,9 @@ fn wide_validation_finds_each_broken_invariant() {
     assert_eq!(broken(&|t| t.nodes[0].child[0] = leaf_ref(5, 1)), "leaf 0x80000005 points past the blocks");
     assert_eq!(broken(&|t| t.blocks[0].prim[0] = 7), "block 0 holds primitive 7 of 2");
     assert_eq!(broken(&|t| t.blocks[0].p[1][1][0] = 3.0), "block 0 lane 0: triangle data of primitive 0 differs from the mesh");
+    // A lane flagged "not a triangle" must hold zero vertices (the block test skips a
+    // block only by its triangles' edge functions).
+    assert_eq!(broken(&|t| t.blocks[0].prim[0] |= 1 << 31), "block 0 lane 0: primitive 0 is not a triangle, yet has vertices");
     assert_eq!(broken(&|t| t.nodes[0].bounds[4][0] = 0.0), "primitive 0 sticks out of its leaf box");
     assert_eq!(broken(&|t| t.nodes[1].child[0] = 1), "node 1 out of range or reached twice");
     assert_eq!(broken(&|t| t.nodes[0].child[1] = 5), "node 5 out of range or reached twice");

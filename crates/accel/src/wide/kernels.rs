@@ -318,29 +318,36 @@ pub fn block_hits_sse(b: &TriBlock, s: &BlockRay, t_min: f32, t_max: f32) -> Opt
         let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
         let w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
         let zero = _mm_setzero_ps();
+        let sign = _mm_set1_ps(-0.0);
+        let prim = _mm_loadu_si128(b.prim.as_ptr().cast());
+        let empty_lanes = _mm_castsi128_ps(_mm_cmpeq_epi32(prim, _mm_set1_epi32(EMPTY as i32)));
+        // Most blocks a ray reaches miss all four triangles, and the edge functions alone
+        // say so: each lane's three are non-zero and not NaN (their product's magnitude is
+        // above zero; one that underflows only sends its lane on to the full test) with
+        // mixed signs (their sign bits differ). The distance, its error bound and the
+        // division are then skipped. A lane that is not a triangle has three equal (zero)
+        // vertices, so its edge functions are zero or NaN and it is never skipped.
+        let nonzero = _mm_cmpgt_ps(_mm_andnot_ps(sign, _mm_mul_ps(_mm_mul_ps(u, v), w)), zero);
+        let mixed = _mm_or_ps(_mm_xor_ps(u, v), _mm_xor_ps(u, w));
+        if _mm_movemask_ps(_mm_or_ps(_mm_and_ps(nonzero, mixed), empty_lanes)) == 0xF {
+            return None;
+        }
         let undecided_edges = _mm_or_ps(
             _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)), _mm_cmpeq_ps(w, zero)),
             _mm_or_ps(_mm_cmpunord_ps(u, v), _mm_cmpunord_ps(w, w)),
         );
-        let neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)), _mm_cmplt_ps(w, zero));
-        let pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)), _mm_cmpgt_ps(w, zero));
-        let outside = _mm_and_ps(neg, pos);
-        let prim = _mm_loadu_si128(b.prim.as_ptr().cast());
-        let empty = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(prim, _mm_set1_epi32(EMPTY as i32)))) as u32;
+        // Where the edge functions are decided (non-zero, not NaN), mixed signs are
+        // "outside". Only the sign bits of the masks below are read (`movemask`), and they
+        // are combined bit by bit, so `mixed`'s sign bits serve as a mask.
+        let outside = mixed;
+        let empty = _mm_movemask_ps(empty_lanes) as u32;
         let other = _mm_movemask_ps(_mm_castsi128_ps(prim)) as u32 & !empty;
-        // Most blocks a ray reaches miss all four triangles: the edge functions alone say
-        // so, and the distance, its error bound and the division are skipped. (A lane that
-        // is not a triangle is never skipped, whatever its vertices.)
-        if (_mm_movemask_ps(_mm_andnot_ps(undecided_edges, outside)) as u32 & !other | empty) == 0xF {
-            return None;
-        }
         let det = _mm_add_ps(_mm_add_ps(u, v), w);
         let (az, bz, cz) = (_mm_mul_ps(sz, az), _mm_mul_ps(sz, bz), _mm_mul_ps(sz, cz));
         let t_scaled = _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, az), _mm_mul_ps(v, bz)), _mm_mul_ps(w, cz));
         let inv_det = _mm_div_ps(_mm_set1_ps(1.0), det);
         let t = _mm_mul_ps(t_scaled, inv_det);
         // pbrt-v4's error bound on t, as `raylab_core::intersect::t_error_bound` writes it.
-        let sign = _mm_set1_ps(-0.0);
         let abs = |x: __m128| _mm_andnot_ps(sign, x);
         let max3 = |a: __m128, b: __m128, c: __m128| _mm_max_ps(_mm_max_ps(abs(a), abs(b)), abs(c));
         let (max_zt, max_xt, max_yt, max_e) = (max3(az, bz, cz), max3(ax, bx, cx), max3(ay, by, cy), max3(u, v, w));
@@ -581,7 +588,8 @@ pub(super) mod tests {
             let lanes = k % 4 + 1;
             let mut b = random_block(k, lanes, scale, &mut r);
             if k % 7 == 0 {
-                b.prim[0] = 3 | TriBlock::OTHER;
+                // Not a triangle: its vertices are zero, as the collapse leaves them.
+                b.set_triangle(0, 3 | TriBlock::OTHER, [Vec3::ZERO; 3]);
             }
             // Origins: the origin, random, or on a lane's triangle (t ≈ 0).
             let o = match k % 3 {

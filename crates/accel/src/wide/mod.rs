@@ -21,7 +21,7 @@ mod ray_major;
 mod traverse;
 
 use rayon::prelude::*;
-use raylab_core::{Aabb, Ray};
+use raylab_core::{Aabb, Ray, Vec3};
 
 use crate::bvh::Bvh;
 use crate::{Accel, AccelStats, Counters, Hit, Primitives, ValidationError};
@@ -399,8 +399,12 @@ impl<const W: usize, N: Layout<W>> Accel for WideBvh<W, N> {
                             return;
                         }
                         seen[i as usize] = true;
-                        let copy = (p & TriBlock::OTHER == 0).then(|| [0, 1, 2].map(|v| blk.vertex(lane, v)));
-                        if copy != prims.triangle(i) {
+                        let copy = [0, 1, 2].map(|v| blk.vertex(lane, v));
+                        if p & TriBlock::OTHER != 0 && copy != [Vec3::ZERO; 3] {
+                            problem = Some(format!("block {} lane {lane}: primitive {i} is not a triangle, yet has vertices", first + k));
+                            return;
+                        }
+                        if (p & TriBlock::OTHER == 0).then_some(copy) != prims.triangle(i) {
                             problem = Some(format!("block {} lane {lane}: triangle data of primitive {i} differs from the mesh", first + k));
                             return;
                         }

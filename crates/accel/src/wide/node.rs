@@ -124,7 +124,8 @@ impl<const W: usize> Layout<W> for WideNode<W> {
 /// mesh so that a leaf test needs no index or vertex loads: 160 bytes.
 ///
 /// Lanes: `prim[l]` is the primitive index; [`TriBlock::OTHER`] marks a primitive that
-/// is not a triangle (tested through `Primitives::intersect`, vertices zero) and
+/// is not a triangle (tested through `Primitives::intersect`; its vertices are zero, which
+/// the block test relies on to never skip it) and
 /// [`EMPTY`] an unused lane.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(16))]
