@@ -92,13 +92,19 @@ impl Packet {
     #[target_feature(enable = "avx2,avx512f,avx512vl")]
     fn new(rays: &[Ray]) -> Option<(Packet, __m512)> {
         let n = rays.len();
-        // The rays' origins, directions and intervals, one lane per ray, gathered from the
-        // slice; lanes past `n` repeat the last ray and are never active.
-        let lane = _mm512_min_epi32(_mm512_set_epi32(15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0), _mm512_set1_epi32(n as i32 - 1));
-        let first = _mm512_mullo_epi32(lane, _mm512_set1_epi32((std::mem::size_of::<Ray>() / 4) as i32));
-        let base = rays.as_ptr().cast::<f32>();
-        // SAFETY: every index is a field of a ray of `rays` (`lane < n`), in f32 units.
-        let field = |offset: usize| unsafe { _mm512_i32gather_ps::<4>(_mm512_add_epi32(first, _mm512_set1_epi32((offset / 4) as i32)), base) };
+        // The rays' origins, directions and intervals, one lane per ray: eight loads of two
+        // rays each, transposed (sixteen gathers' worth of loads cost more). Lanes past `n`
+        // repeat the last ray and are never active.
+        let padded: [Ray; PACKET];
+        let src = if n == PACKET {
+            rays.as_ptr()
+        } else {
+            padded = std::array::from_fn(|r| rays[r.min(n - 1)]);
+            padded.as_ptr()
+        };
+        // SAFETY: `src` points to 16 rays of 8 f32 each (`RAY_F32`), two per 64-byte load.
+        let fields = transpose(std::array::from_fn(|k| unsafe { _mm512_loadu_ps(src.cast::<f32>().add(16 * k)) }));
+        let field = |offset: usize| fields[offset / 4];
         let (o, d) = (std::mem::offset_of!(Ray, origin), std::mem::offset_of!(Ray, dir));
         let (origin, dir) = ([0, 4, 8].map(|a| field(o + a)), [0, 4, 8].map(|a| field(d + a)));
         let (t_min, t_max) = (field(std::mem::offset_of!(Ray, t_min)), field(std::mem::offset_of!(Ray, t_max)));
@@ -130,8 +136,13 @@ impl Packet {
             0xFFFF => std::mem::swap(&mut kx, &mut ky),
             _ => return None,
         }
+        // `1/d[kz]` is `inv[kz]` (`1/(d + 0)`) unless `d[kz]` is `-0`: a zero direction,
+        // left to the child-major path.
+        if _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(dir[kz], zero) != 0 {
+            return None;
+        }
         let robust_far = _mm512_set1_ps(ROBUST_FAR);
-        let shear = [_mm512_div_ps(dir[kx], dir[kz]), _mm512_div_ps(dir[ky], dir[kz]), _mm512_div_ps(one, dir[kz])];
+        let shear = [_mm512_div_ps(dir[kx], dir[kz]), _mm512_div_ps(dir[ky], dir[kz]), inv[kz]];
         let inv_far = inv.map(|i| _mm512_mul_ps(i, robust_far));
         // The same constants ray by ray, for leaves that one ray reaches.
         let mut each = [Lanes([0.0; PACKET]); 6];
@@ -139,14 +150,18 @@ impl Packet {
             // SAFETY: `Lanes` is 64-byte aligned.
             unsafe { _mm512_store_ps(each[k].0.as_mut_ptr(), *x) };
         }
-        let min = |x: __m512| _mm512_reduce_min_ps(x);
-        let max = |x: __m512| _mm512_reduce_max_ps(x);
         let inf = _mm512_set1_ps(f32::INFINITY);
         let finite = |x: &__m512| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(_mm512_abs_ps(*x), inf) == 0xFFFF;
         let frustum = (origin.iter().chain(&inv).chain(&inv_far).all(finite) && finite(&t_min)).then(|| {
-            let (lo, hi) = (origin.map(min), origin.map(max));
+            // Thirteen reductions at once: maxima as negated minima of the negated lanes
+            // (exact for finite values).
+            let neg = |x: __m512| _mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(x), _mm512_set1_epi32(i32::MIN)));
+            let [o0, o1, o2] = origin;
+            let [i0, i1, i2] = inv;
+            let least = least_of_each([o0, o1, o2, neg(o0), neg(o1), neg(o2), i0, i1, i2, neg(i0), neg(i1), neg(i2), t_min, t_min, t_min, t_min]);
+            let (lo, hi) = ([least[0], least[1], least[2]], [-least[3], -least[4], -least[5]]);
             let along = |a: usize, pos: [f32; 3], neg: [f32; 3]| if negative[a] == 0 { pos[a] } else { neg[a] };
-            let inv = inv.map(|i| [min(i), max(i)]);
+            let inv = [0, 1, 2].map(|a| [least[6 + a], -least[9 + a]]);
             Frustum {
                 near_origin: [0, 1, 2].map(|a| along(a, hi, lo)),
                 far_origin: [0, 1, 2].map(|a| along(a, lo, hi)),
@@ -154,11 +169,55 @@ impl Packet {
                 // Rounding is monotone: the extremes of `inv · ROBUST_FAR` are those of `inv`
                 // times it, as each lane computes it.
                 inv_far: inv.map(|[l, h]| [l * ROBUST_FAR, h * ROBUST_FAR]),
-                t_min: min(t_min),
+                t_min: least[12],
             }
         });
         Some((Packet { origin, inv, inv_far, t_min, shear, near_rows, far_rows, axes: (kx, ky, kz), each, frustum }, t_max))
     }
+}
+
+/// Floats per [`Ray`]: a packet's rays load as 64-byte pairs.
+const RAY_F32: usize = 8;
+const _: () = assert!(std::mem::size_of::<Ray>() == 4 * RAY_F32);
+
+/// Lane `i` of `[a | b]`'s even lanes (`EVEN[i] = 2i`) and odd lanes, as indices of
+/// `_mm512_permutex2var_ps`.
+const EVEN: [i32; 16] = [0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30];
+const ODD: [i32; 16] = [1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31];
+
+/// Sixteen rays of eight f32, two per register (rays `2k` and `2k + 1` in `v[k]`), as
+/// eight registers of one field each (field `f` of ray `r` in lane `r` of the result's
+/// `f`-th): three stages that each split register pairs into even and odd lanes.
+#[inline]
+#[target_feature(enable = "avx512f")]
+fn transpose(v: [__m512; RAY_F32]) -> [__m512; RAY_F32] {
+    // SAFETY: the index arrays hold 16 i32.
+    let (even, odd) = unsafe { (_mm512_loadu_si512(EVEN.as_ptr().cast()), _mm512_loadu_si512(ODD.as_ptr().cast())) };
+    let split = |a: __m512, b: __m512| (_mm512_permutex2var_ps(a, even, b), _mm512_permutex2var_ps(a, odd, b));
+    // Stage `s` splits registers `r` and `r | 1 << s`.
+    let [a0, a1, a2, a3, a4, a5, a6, a7] = v;
+    let ((a0, a1), (a2, a3), (a4, a5), (a6, a7)) = (split(a0, a1), split(a2, a3), split(a4, a5), split(a6, a7));
+    let ((a0, a2), (a1, a3), (a4, a6), (a5, a7)) = (split(a0, a2), split(a1, a3), split(a4, a6), split(a5, a7));
+    let ((a0, a4), (a1, a5), (a2, a6), (a3, a7)) = (split(a0, a4), split(a1, a5), split(a2, a6), split(a3, a7));
+    [a0, a1, a2, a3, a4, a5, a6, a7]
+}
+
+/// The least lane of each of sixteen registers: four stages that each pair registers and
+/// take the lesser of each pair of neighbouring lanes (the even and odd lanes of `[a | b]`),
+/// 30 shuffles where sixteen separate reductions take 64.
+#[inline]
+#[target_feature(enable = "avx512f")]
+fn least_of_each(v: [__m512; 16]) -> [f32; 16] {
+    // SAFETY: the index arrays hold 16 i32.
+    let (even, odd) = unsafe { (_mm512_loadu_si512(EVEN.as_ptr().cast()), _mm512_loadu_si512(ODD.as_ptr().cast())) };
+    let least = |a: __m512, b: __m512| _mm512_min_ps(_mm512_permutex2var_ps(a, even, b), _mm512_permutex2var_ps(a, odd, b));
+    let v: [__m512; 8] = std::array::from_fn(|k| least(v[2 * k], v[2 * k + 1]));
+    let v: [__m512; 4] = std::array::from_fn(|k| least(v[2 * k], v[2 * k + 1]));
+    let v: [__m512; 2] = std::array::from_fn(|k| least(v[2 * k], v[2 * k + 1]));
+    let mut out = Lanes([0.0; PACKET]);
+    // SAFETY: `Lanes` is 64-byte aligned.
+    unsafe { _mm512_store_ps(out.0.as_mut_ptr(), least(v[0], v[1])) };
+    out.0
 }
 
 /// What each ray has found so far: its `t_max` (the best hit's distance once it has one),
@@ -467,15 +526,20 @@ fn triangle(b: &TriBlock, j: usize, p: &Packet, (kx, ky, kz): (usize, usize, usi
     let v = _mm512_sub_ps(_mm512_mul_ps(ax, cy), _mm512_mul_ps(ay, cx));
     let w = _mm512_sub_ps(_mm512_mul_ps(bx, ay), _mm512_mul_ps(by, ax));
     let zero = _mm512_setzero_ps();
-    let eq0 = |x: __m512| _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(x, zero);
-    let lt0 = |x: __m512| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(x, zero);
-    let gt0 = |x: __m512| _mm512_cmp_ps_mask::<_CMP_GT_OQ>(x, zero);
-    let undecided_edges = eq0(u) | eq0(v) | eq0(w) | _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(u, v) | _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(w, w);
-    let outside = (lt0(u) | lt0(v) | lt0(w)) & (gt0(u) | gt0(v) | gt0(w));
-    // Most rays reaching a leaf miss most of its triangles: the edge functions say so.
-    if active & !(outside & !undecided_edges) == 0 {
+    // Mixed signs: the sign bits differ (read as integers below zero).
+    let bits = _mm512_castps_si512;
+    let mixed = _mm512_cmplt_epi32_mask(_mm512_or_si512(_mm512_xor_si512(bits(u), bits(v)), _mm512_xor_si512(bits(u), bits(w))), _mm512_setzero_si512());
+    // Most rays reaching a leaf miss most of its triangles, and the edge functions say
+    // so: all three non-zero and not NaN (their product's magnitude above zero, as in
+    // `triangles_sse`) with mixed signs.
+    let nonzero = _mm512_cmp_ps_mask::<_CMP_GT_OQ>(_mm512_abs_ps(_mm512_mul_ps(_mm512_mul_ps(u, v), w)), zero);
+    if active & !(nonzero & mixed) == 0 {
         return (0, 0, zero, zero, zero);
     }
+    let eq0 = |x: __m512| _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(x, zero);
+    let undecided_edges = eq0(u) | eq0(v) | eq0(w) | _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(u, v) | _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(w, w);
+    // Where the edge functions are decided, mixed signs are "outside".
+    let outside = mixed;
     let det = _mm512_add_ps(_mm512_add_ps(u, v), w);
     let (az, bz, cz) = (_mm512_mul_ps(sz, az), _mm512_mul_ps(sz, bz), _mm512_mul_ps(sz, cz));
     let t_scaled = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(u, az), _mm512_mul_ps(v, bz)), _mm512_mul_ps(w, cz));
@@ -775,6 +839,54 @@ mod tests {
             culled += (!kept & 0xFF).count_ones();
         }
         assert!(packets > 2000 && entered > 3000 && culled > 3000, "too few cases: {packets} packets, {entered} children entered, {culled} culled");
+    }
+
+    /// The packet's constants, loaded by the transpose and reduced all at once, are each
+    /// ray's own (`RayBoxes::new`, `ShearedRay::new`) and their exact extremes, for packets
+    /// of 1 to 16 rays (lanes past the count repeat the last ray).
+    #[test]
+    fn packet_constants_are_each_rays_own_and_their_extremes() {
+        use super::super::kernels::RayBoxes;
+        use raylab_core::intersect::ShearedRay;
+        use std::is_x86_feature_detected as has;
+        if !(has!("avx512f") && has!("avx512vl") && has!("avx2")) {
+            return;
+        }
+        let mut rng = Pcg32::new(3, 9);
+        let mut f = |s: f32| (rng.next_f32() - 0.5) * s;
+        let lanes = |x: core::arch::x86_64::__m512| -> [f32; PACKET] { unsafe { std::mem::transmute(x) } };
+        let mut taken = 0;
+        for k in 0..400 {
+            let n = 1 + k % PACKET;
+            let rays: Vec<Ray> = (0..n).map(|_| Ray::segment(Vec3::new(f(8.0), f(8.0), f(8.0)), Vec3::new(0.3 + f(0.2), -0.2 + f(0.2), 1.0 + f(0.4)), f(0.1).abs(), 5.0 + f(4.0))).collect();
+            // SAFETY: features checked above.
+            let Some((p, t_max)) = (unsafe { super::Packet::new(&rays) }) else { continue };
+            taken += 1;
+            let fr = p.frustum.as_ref().expect("finite constants");
+            for r in 0..PACKET {
+                let ray = &rays[r.min(n - 1)];
+                let (rb, sh) = (RayBoxes::new(ray), ShearedRay::new(ray));
+                let bits = |x: &[f32]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+                let got = |xs: &[core::arch::x86_64::__m512]| xs.iter().map(|&x| lanes(x)[r]).collect::<Vec<_>>();
+                assert_eq!(bits(&got(&p.origin)), bits(&rb.origin), "packet {k} ray {r}: origin");
+                assert_eq!(bits(&got(&p.inv)), bits(&rb.inv), "packet {k} ray {r}: inverse");
+                assert_eq!(bits(&got(&p.inv_far)), bits(&rb.inv_far), "packet {k} ray {r}: inverse for far planes");
+                assert_eq!(bits(&got(&p.shear)), bits(&[sh.sx, sh.sy, sh.sz]), "packet {k} ray {r}: shear");
+                assert_eq!((lanes(p.t_min)[r], lanes(t_max)[r]), (rb.t_min, ray.t_max), "packet {k} ray {r}: interval");
+                assert_eq!(p.axes, (sh.kx, sh.ky, sh.kz), "packet {k}: shear axes");
+                assert_eq!((p.near_rows, p.far_rows), (rb.near, rb.far), "packet {k}: box rows");
+            }
+            let ext = |g: &dyn Fn(&Ray) -> f32| (rays.iter().map(g).fold(f32::INFINITY, f32::min), rays.iter().map(g).fold(f32::NEG_INFINITY, f32::max));
+            for a in 0..3 {
+                let (lo, hi) = ext(&|r: &Ray| r.origin[a]);
+                let (near, far) = if p.near_rows[a] == a { (hi, lo) } else { (lo, hi) };
+                assert_eq!((fr.near_origin[a], fr.far_origin[a]), (near, far), "packet {k} axis {a}: frustum origins");
+                let (lo, hi) = ext(&|r: &Ray| RayBoxes::new(r).inv[a]);
+                assert_eq!(fr.inv[a], [lo, hi], "packet {k} axis {a}: frustum inverses");
+            }
+            assert_eq!(fr.t_min, ext(&|r: &Ray| r.t_min + 0.0).0, "packet {k}: frustum t_min");
+        }
+        assert!(taken > 300, "too few packets taken: {taken}");
     }
 
     /// A ray with a zero direction component has an infinite inverse: no frustum, and the
