@@ -345,17 +345,21 @@ pub fn block_hits_sse(b: &TriBlock, s: &BlockRay, t_min: f32, t_max: f32) -> Opt
         let det = _mm_add_ps(_mm_add_ps(u, v), w);
         let (az, bz, cz) = (_mm_mul_ps(sz, az), _mm_mul_ps(sz, bz), _mm_mul_ps(sz, cz));
         let t_scaled = _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, az), _mm_mul_ps(v, bz)), _mm_mul_ps(w, cz));
-        let inv_det = _mm_div_ps(_mm_set1_ps(1.0), det);
-        let t = _mm_mul_ps(t_scaled, inv_det);
         // pbrt-v4's error bound on t, as `raylab_core::intersect::t_error_bound` writes it.
         let abs = |x: __m128| _mm_andnot_ps(sign, x);
         let max3 = |a: __m128, b: __m128, c: __m128| _mm_max_ps(_mm_max_ps(abs(a), abs(b)), abs(c));
-        let (max_zt, max_xt, max_yt, max_e) = (max3(az, bz, cz), max3(ax, bx, cx), max3(ay, by, cy), max3(u, v, w));
+        let (max_zt, max_xt, max_yt) = (max3(az, bz, cz), max3(ax, bx, cx), max3(ay, by, cy));
         let g = |n: u32| _mm_set1_ps(raylab_core::gamma(n));
-        let delta_z = _mm_mul_ps(g(3), max_zt);
         let delta_x = _mm_mul_ps(g(5), _mm_add_ps(max_xt, max_zt));
         let delta_y = _mm_mul_ps(g(5), _mm_add_ps(max_yt, max_zt));
         let delta_e = _mm_mul_ps(_mm_set1_ps(2.0), _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_mul_ps(g(2), max_xt), max_yt), _mm_mul_ps(delta_y, max_xt)), _mm_mul_ps(delta_x, max_yt)));
+        if behind_for_sure(det, t_scaled, max_zt, delta_e, nonzero, mixed, empty_lanes) {
+            return None;
+        }
+        let inv_det = _mm_div_ps(_mm_set1_ps(1.0), det);
+        let t = _mm_mul_ps(t_scaled, inv_det);
+        let max_e = max3(u, v, w);
+        let delta_z = _mm_mul_ps(g(3), max_zt);
         let delta_t = _mm_mul_ps(
             _mm_mul_ps(_mm_set1_ps(3.0), _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_mul_ps(g(3), max_e), max_zt), _mm_mul_ps(delta_e, max_zt)), _mm_mul_ps(delta_z, max_e))),
             abs(inv_det),
@@ -376,6 +380,38 @@ pub fn block_hits_sse(b: &TriBlock, s: &BlockRay, t_min: f32, t_max: f32) -> Opt
         _mm_storeu_ps(out.u.as_mut_ptr(), _mm_mul_ps(v, inv_det));
         _mm_storeu_ps(out.v.as_mut_ptr(), _mm_mul_ps(w, inv_det));
         Some(out)
+    }
+}
+
+/// Whether every lane of a block is settled without the distance's division and its full
+/// error bound: empty, rejected by its edge functions (`nonzero` and `mixed`, see
+/// [`block_hits_sse`]), or, with its edge functions all of one sign, certainly behind the
+/// origin as [`block_hits_sse`] would decide it (`t < -δt`). A ray leaving a surface meets
+/// the triangle it leaves this way in nearly every block it tests that is not a miss.
+///
+/// The test divides nothing. With `E = max(|u|, |v|, |w|) <= |det|·(1 + 3ε)` (one sign)
+/// and `δz = γ₃·max_zt`, the bound is `δt = 3·(γ₃·E·max_zt + δe·max_zt + δz·E) / |det|
+/// <= 3·max_zt·(2γ₃·|det| + δe) / |det|`, so `-t_scaled·sign(det) > 2·R` with
+/// `R = 3·max_zt·(2γ₃·|det| + δe)` gives `t < -δt` with room for every rounding of
+/// both computations. The magnitudes are kept within `[2⁻⁶³, 2⁶³]` so that neither
+/// computation under- or overflows; other lanes go on to the full test.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn behind_for_sure(det: std::arch::x86_64::__m128, t_scaled: std::arch::x86_64::__m128, max_zt: std::arch::x86_64::__m128, delta_e: std::arch::x86_64::__m128, nonzero: std::arch::x86_64::__m128, mixed: std::arch::x86_64::__m128, empty: std::arch::x86_64::__m128) -> bool {
+    use std::arch::x86_64::*;
+    // SAFETY: SSE2 is in the x86-64 baseline.
+    unsafe {
+        let sign = _mm_set1_ps(-0.0);
+        let det_abs = _mm_andnot_ps(sign, det);
+        let r = _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(3.0), max_zt), _mm_add_ps(_mm_mul_ps(_mm_set1_ps(2.0 * raylab_core::gamma(3)), det_abs), delta_e));
+        // `t_scaled·sign(det)` (exact), below `-2R`.
+        let toward = _mm_xor_ps(t_scaled, _mm_and_ps(det, sign));
+        let behind = _mm_cmplt_ps(toward, _mm_mul_ps(_mm_set1_ps(-2.0), r));
+        let (lo, hi) = (_mm_set1_ps(2f32.powi(-63)), _mm_set1_ps(2f32.powi(63)));
+        let sane = _mm_and_ps(_mm_and_ps(_mm_cmpge_ps(det_abs, lo), _mm_cmple_ps(det_abs, hi)), _mm_and_ps(_mm_cmpge_ps(r, lo), _mm_cmple_ps(_mm_andnot_ps(sign, t_scaled), hi)));
+        // Lanes rejected by their edges, or decided (`nonzero`) of one sign and behind.
+        let settled = _mm_and_ps(nonzero, _mm_or_ps(mixed, _mm_and_ps(behind, sane)));
+        _mm_movemask_ps(_mm_or_ps(settled, empty)) == 0xF
     }
 }
 
@@ -570,6 +606,56 @@ pub(super) mod tests {
             b.set_triangle(l, l as u32, v);
         }
         b
+    }
+
+    /// Rays leaving a triangle, or arriving at it, from a few ulps to a thousandth of its
+    /// size off its plane (what `behind_for_sure` settles without the division): the
+    /// four-wide kernel still gives the scalar kernel's answer lane by lane, the triangle
+    /// behind is skipped, and the tiny hits ahead are found.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn rays_leaving_or_reaching_a_triangle_get_the_scalar_answers() {
+        let mut rng = raylab_core::Pcg32::new(17, 5);
+        let mut r = |scale: f32| Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, rng.next_f32() - 0.5) * scale;
+        let (mut near_hits, mut behind, mut skipped) = (0, 0, 0);
+        for k in 0..20000 {
+            let scale = [1.0, 1e-4, 1e4, 1e-12][k % 4];
+            let mut b = random_block(k, 1 + k % 4, scale, &mut r);
+            let (p0, p1, p2) = (r(scale), r(scale), r(scale));
+            b.set_triangle(0, 0, [p0, p1, p2]);
+            let Some(n) = (p1 - p0).cross(p2 - p0).try_normalize() else { continue };
+            let inside = p0 + 0.2 * (p1 - p0) + 0.3 * (p2 - p0);
+            // Off the plane by 2^-(4..24) of its size, on either side, leaving or arriving.
+            let h = scale * 2f32.powi(-4 - (k / 4 % 21) as i32) * if k % 2 == 0 { 1.0 } else { -1.0 };
+            let o = inside + n * h;
+            let leave = if k % 3 == 0 { -1.0 } else { 1.0 };
+            let d = (n * (h.signum() * leave) + r(1.5)).try_normalize().unwrap_or(n);
+            let ray = Ray::new(o, d);
+            let s = ShearedRay::new(&ray);
+            let h4 = triangles_sse(&b, &s, 0.0, f32::INFINITY);
+            if h4.hit == 0 && h4.exact == 0 {
+                skipped += 1;
+            }
+            for l in 0..4 {
+                let bit = 1 << l;
+                if b.prim[l] == EMPTY || h4.exact & bit != 0 {
+                    continue;
+                }
+                let scalar = s.triangle(0.0, f32::INFINITY, b.vertex(l, 0), b.vertex(l, 1), b.vertex(l, 2));
+                let simd = (h4.hit & bit != 0).then(|| (h4.t[l], h4.u[l], h4.v[l]));
+                assert_eq!(simd.map(|(t, u, v)| [t, u, v].map(f32::to_bits)), scalar.map(|(t, u, v)| [t, u, v].map(f32::to_bits)), "block {k} lane {l}");
+                if l == 0 {
+                    // Leaving: moving further from the plane than the origin is.
+                    let leaving = n.dot(d) * h > 0.0;
+                    match scalar {
+                        Some((t, _, _)) if t < 1e-3 * scale => near_hits += 1,
+                        None if leaving => behind += 1,
+                        _ => {}
+                    }
+                }
+            }
+        }
+        assert!(near_hits > 2000 && behind > 2000 && skipped > 2000, "too few cases: {near_hits} tiny hits, {behind} triangles behind, {skipped} blocks settled");
     }
 
     /// The four-wide kernel decides each lane exactly as the scalar kernel does (same `t`
