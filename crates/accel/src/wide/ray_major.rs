@@ -93,7 +93,7 @@ impl Packet {
     fn new(rays: &[Ray]) -> Option<(Packet, __m512)> {
         let n = rays.len();
         // The rays' origins, directions and intervals, one lane per ray: eight loads of two
-        // rays each, transposed (sixteen gathers' worth of loads cost more). Lanes past `n`
+        // rays each, transposed (eight 16-lane gathers cost more). Lanes past `n`
         // repeat the last ray and are never active.
         let padded: [Ray; PACKET];
         let src = if n == PACKET {
@@ -203,8 +203,8 @@ fn transpose(v: [__m512; RAY_F32]) -> [__m512; RAY_F32] {
 }
 
 /// The least lane of each of sixteen registers: four stages that each pair registers and
-/// take the lesser of each pair of neighbouring lanes (the even and odd lanes of `[a | b]`),
-/// 30 shuffles where sixteen separate reductions take 64.
+/// take the lesser of each pair of neighbouring lanes (the even and odd lanes of `[a | b]`):
+/// 30 shuffles for sixteen minima, where each reduction alone takes four.
 #[inline]
 #[target_feature(enable = "avx512f")]
 fn least_of_each(v: [__m512; 16]) -> [f32; 16] {
