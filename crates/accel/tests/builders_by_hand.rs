@@ -328,6 +328,21 @@ fn binned_sah_in_blocks_splits_a_large_primitive_from_small_ones() {
 }
 
 #[test]
+fn binned_sah_in_blocks_tries_every_cut_of_four() {
+    // The large cube of the test above (half area 300), now centred at x = 1 between small
+    // ones at x = 0.8, 1.2 and 1.4 (their union 0.7 × 0.1 × 0.1, half area 0.15). No plane
+    // isolates it: the plane cuts cost 1 + (0.03·c(1) + 300·c(3))/300 = 3.05, 1 + (300·c(2)
+    // + 0.07·c(2))/300 = 2.70 and 3.05 again, all above a leaf's c(4) = 2.4, so bins would
+    // make a leaf. Of every cut, {1} | {0, 2, 3} costs 1 + (300·1.35 + 0.15·2.05)/300 =
+    // 2.351: a split. The small ones stay a leaf (2.05 against 2.06 and 2.52 for their
+    // cuts).
+    let s = Boxes(vec![cube_at(0.8, 0.05), cube_at(1.0, 5.0), cube_at(1.2, 0.05), cube_at(1.4, 0.05)]);
+    let b = Bvh::build(&s, SplitMethod::BinnedSah, &BuildOptions { leaf_block: 4, ..opts(1.0, 1.0, 8, 16) });
+    b.validate(&s).unwrap();
+    assert_eq!(shape(&b), "(1 [0 2 3])");
+}
+
+#[test]
 fn wide_layouts_count_in_blocks_only_when_every_primitive_is_a_triangle() {
     // The rows of `binned_sah_counts_in_blocks_for_the_wide_layouts` as triangles, each
     // spanning its unit cube: in blocks, one leaf per row. With the last one a sphere of

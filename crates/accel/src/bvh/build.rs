@@ -120,6 +120,10 @@ impl Ctx {
     }
 }
 
+/// Nodes counted in blocks of at most this many primitives are split by trying every cut
+/// ([`Ctx::split_tiny`]).
+const TINY: usize = 4;
+
 /// A split: the size of the left part (now in front) and the extents of both parts.
 type Split = (usize, Extent, Extent);
 
@@ -273,6 +277,7 @@ impl Ctx {
             return (refs.len() > self.max_leaf).then(|| (halves(refs, refs.len() / 2), false));
         }
         match self.method {
+            SplitMethod::BinnedSah if refs.len() <= TINY.min(self.block) => self.split_tiny(refs, extent).map(|s| (s, false)),
             SplitMethod::BinnedSah => self.split_sah(h, extent, scratch).map(|s| (s, true)),
             SplitMethod::Median => (refs.len() > self.max_leaf).then(|| (split_median(refs, axis), false)),
             SplitMethod::Midpoint => {
@@ -288,6 +293,50 @@ impl Ctx {
                 Some((partition(refs, h.spare, m, left), true))
             }
         }
+    }
+
+    /// The binned SAH's choice for a node of at most [`TINY`] primitives, made by trying
+    /// every way to cut them in two (at most seven) instead of binning: half the nodes are
+    /// this small when counting in blocks, and there clearing, filling and sweeping bins
+    /// cost more than the exact answer. Reorders `refs` in place, the left side first.
+    fn split_tiny(&self, refs: &mut [PrimRef], extent: &Extent) -> Option<Split> {
+        let n = refs.len();
+        debug_assert!((2..=TINY).contains(&n));
+        let pa = extent.geom.half_area();
+        let flat = pa <= 0.0;
+        let weight = |b: &Box3| if flat { 1.0 } else { b.half_area() };
+        let mut boxes = [Box3::EMPTY; TINY];
+        for (b, r) in boxes.iter_mut().zip(refs.iter()) {
+            *b = r.bounds();
+        }
+        // The last primitive always on the right: each cut once.
+        let (mut best_x, mut best_mask) = (f32::INFINITY, 0u32);
+        for mask in 1..1u32 << (n - 1) {
+            let (mut l, mut r) = (Box3::EMPTY, Box3::EMPTY);
+            for (i, b) in boxes[..n].iter().enumerate() {
+                if mask >> i & 1 != 0 {
+                    l = l.union(*b);
+                } else {
+                    r = r.union(*b);
+                }
+            }
+            let nl = mask.count_ones() as usize;
+            let x = weight(&l) * self.blocks(nl) + weight(&r) * self.blocks(n - nl);
+            if x < best_x {
+                (best_x, best_mask) = (x, mask);
+            }
+        }
+        let best_cost = self.sah.traversal + self.sah.intersection * if flat { best_x } else { best_x / pa };
+        if best_cost >= self.sah.intersection * self.blocks(n) && n <= self.max_leaf {
+            return None;
+        }
+        let mut all = [refs[0]; TINY];
+        all[..n].copy_from_slice(refs);
+        let left = |i: &usize| best_mask >> i & 1 != 0;
+        for (to, i) in refs.iter_mut().zip((0..n).filter(left).chain((0..n).filter(|i| !left(i)))) {
+            *to = all[i];
+        }
+        Some(halves(refs, best_mask.count_ones() as usize))
     }
 
     /// Binned SAH over all three axes (Wald 2007, "On fast Construction of SAH-based
