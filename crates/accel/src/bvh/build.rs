@@ -427,24 +427,68 @@ fn halves(refs: &[PrimRef], mid: usize) -> Split {
 /// Bins of the three axes, `nb` per axis (axis-major, in the first `3 nb` entries): the union of the boxes whose
 /// centroid falls in each bin, and their count.
 ///
-/// Binning keeps two sets of bins, one for the even primitives and one for the odd ones,
-/// and folds the second into the first at the end of [`Bins::add`]. Consecutive primitives
-/// of a mesh often fall in the same bin, and each update of a bin then waits for the
-/// previous one's store to reach its load (store forwarding plus the `min`/`max`): with
-/// two sets, two such chains run side by side.
+/// Binning keeps [`SETS`] sets of bins, primitive `i` going to set `i mod SETS` (two sets
+/// below [`FOUR_SETS`] primitives), and folds the others into the first at the end of
+/// [`Bins::add`]. Consecutive primitives of a mesh often fall in the same bin, and each
+/// update of a bin then waits for the previous one's store to reach its load (store
+/// forwarding plus the `min`/`max`): with several sets, that many such chains run side by
+/// side.
 struct Bins {
     bounds: Vec<Box3>,
     count: Vec<usize>,
-    /// Where the second set starts: `3 nb` of the largest `nb` the bins were made for.
-    second: usize,
+    /// Where each further set starts: `3 nb` of the largest `nb` the bins were made for.
+    stride: usize,
+}
+
+/// Sets of bins (see [`Bins`]).
+const SETS: usize = 4;
+
+/// Nodes from this many primitives bin into all [`SETS`] sets; smaller ones into two, whose
+/// fold costs less.
+const FOUR_SETS: usize = 128;
+
+/// Where a centroid falls: bin `⌊clamp((c - lo) · scale, 0, nb - 1)⌋` on each axis.
+struct Binning {
+    lo: Vec3A,
+    scale: Vec3A,
+    top: Vec3A,
+    nb: usize,
+}
+
+impl Binning {
+    /// Bins `refs` into the first `S` sets, primitive `i` into set `i mod S`; returns `S`.
+    #[inline(always)]
+    fn add_in_sets<const S: usize>(&self, refs: &[PrimRef], bounds: &mut [&mut [Box3]; SETS], count: &mut [&mut [usize]; SETS]) -> usize {
+        let mut groups = refs.chunks_exact(S);
+        for group in &mut groups {
+            for s in 0..S {
+                self.bin(&group[s], bounds[s], count[s]);
+            }
+        }
+        for (s, r) in groups.remainder().iter().enumerate() {
+            self.bin(r, bounds[s], count[s]);
+        }
+        S
+    }
+
+    #[inline(always)]
+    fn bin(&self, r: &PrimRef, bounds: &mut [Box3], count: &mut [usize]) {
+        // In [0, nb - 1]: a NaN became 0 at `max`.
+        let bin = truncate(((r.centroid() - self.lo) * self.scale).max(Vec3A::ZERO).min(self.top));
+        for (axis, b) in bin.into_iter().enumerate() {
+            let k = axis * self.nb + b as usize;
+            bounds[k].grow(r.min(), r.max);
+            count[k] += 1;
+        }
+    }
 }
 
 impl Bins {
     fn new(nb: usize) -> Self {
-        Self { bounds: vec![Box3::EMPTY; 6 * nb], count: vec![0; 6 * nb], second: 3 * nb }
+        Self { bounds: vec![Box3::EMPTY; SETS * 3 * nb], count: vec![0; SETS * 3 * nb], stride: 3 * nb }
     }
 
-    /// Empties the first `nb` bins of each axis (the second set is empty between calls).
+    /// Empties the first `nb` bins of each axis (the other sets are empty between calls).
     fn clear(&mut self, nb: usize) {
         self.bounds[..3 * nb].fill(Box3::EMPTY);
         self.count[..3 * nb].fill(0);
@@ -456,40 +500,30 @@ impl Bins {
     /// hence the same tree, whatever the thread count.
     #[inline]
     fn add(&mut self, refs: &[PrimRef], nb: usize, lo: Vec3A, scale: Vec3A) {
-        let top = Vec3A::splat((nb - 1) as f32);
-        let (bounds, more_bounds) = self.bounds.split_at_mut(self.second);
-        let (count, more_count) = self.count.split_at_mut(self.second);
-        let (bounds, count) = (&mut bounds[..3 * nb], &mut count[..3 * nb]);
-        let (more_bounds, more_count) = (&mut more_bounds[..3 * nb], &mut more_count[..3 * nb]);
-        let bin = |r: &PrimRef, bounds: &mut [Box3], count: &mut [usize]| {
-            // In [0, nb - 1]: a NaN became 0 at `max`.
-            let bin = truncate(((r.centroid() - lo) * scale).max(Vec3A::ZERO).min(top));
-            for (axis, b) in bin.into_iter().enumerate() {
-                let k = axis * nb + b as usize;
-                bounds[k].grow(r.min(), r.max);
-                count[k] += 1;
+        let at = Binning { lo, scale, top: Vec3A::splat((nb - 1) as f32), nb };
+        let stride = self.stride;
+        let mut bounds: [&mut [Box3]; SETS] = Default::default();
+        let mut count: [&mut [usize]; SETS] = Default::default();
+        for ((b, c), (set_b, set_c)) in bounds.iter_mut().zip(&mut count).zip(self.bounds.chunks_exact_mut(stride).zip(self.count.chunks_exact_mut(stride))) {
+            (*b, *c) = (&mut set_b[..3 * nb], &mut set_c[..3 * nb]);
+        }
+        let sets = if refs.len() >= FOUR_SETS { at.add_in_sets::<SETS>(refs, &mut bounds, &mut count) } else { at.add_in_sets::<2>(refs, &mut bounds, &mut count) };
+        let [first, rest @ ..] = &mut bounds;
+        let [first_count, rest_count @ ..] = &mut count;
+        for (more, more_count) in rest[..sets - 1].iter_mut().zip(&mut rest_count[..sets - 1]) {
+            for k in 0..3 * nb {
+                first[k] = first[k].union(std::mem::replace(&mut more[k], Box3::EMPTY));
+                first_count[k] += std::mem::take(&mut more_count[k]);
             }
-        };
-        let mut pairs = refs.chunks_exact(2);
-        for pair in &mut pairs {
-            bin(&pair[0], bounds, count);
-            bin(&pair[1], more_bounds, more_count);
-        }
-        if let [r] = pairs.remainder() {
-            bin(r, bounds, count);
-        }
-        for k in 0..3 * nb {
-            bounds[k] = bounds[k].union(std::mem::replace(&mut more_bounds[k], Box3::EMPTY));
-            count[k] += std::mem::take(&mut more_count[k]);
         }
     }
 
-    /// Adds `o`'s bins to these (first sets only: the second is empty between calls).
+    /// Adds `o`'s bins to these (first sets only: the others are empty between calls).
     fn merge(mut self, o: Bins) -> Bins {
-        for (a, b) in self.bounds[..self.second].iter_mut().zip(&o.bounds[..o.second]) {
+        for (a, b) in self.bounds[..self.stride].iter_mut().zip(&o.bounds[..o.stride]) {
             *a = a.union(*b);
         }
-        for (a, b) in self.count[..self.second].iter_mut().zip(&o.count[..o.second]) {
+        for (a, b) in self.count[..self.stride].iter_mut().zip(&o.count[..o.stride]) {
             *a += b;
         }
         self
@@ -579,17 +613,17 @@ mod tests {
         eq(&a.geom, &b.geom) && eq(&a.cent, &b.cent)
     }
 
-    /// Binning in two sets gives the bins of one set, primitive by primitive, also over
-    /// calls that reuse the bins (the second set must be folded and emptied each time) and
-    /// for odd counts.
+    /// Binning in several sets gives the bins of one set, primitive by primitive, also over
+    /// calls that reuse the bins (the other sets must be folded and emptied each time), for
+    /// counts that no set count divides, in two sets and in four.
     #[test]
-    fn two_sets_bin_as_one() {
+    fn several_sets_bin_as_one() {
         let mut rng = raylab_core::Pcg32::new(7, 1);
         let mut next = move || rng.next_f32();
         let nb = 9;
         let (lo, scale) = (Vec3A::ZERO, Vec3A::splat(nb as f32 / 10.0));
         let mut bins = Bins::new(16);
-        for n in [1, 2, 7, 1000, 1001] {
+        for n in [1, 2, 7, 127, 1000, 1001, 1003] {
             let refs: Vec<PrimRef> = (0..n as u32)
                 .map(|id| {
                     let min = Vec3A::new(next(), next(), next()) * 9.0;
