@@ -205,7 +205,8 @@ pub struct BuildOptions {
     /// `logBlockSize`): a leaf costs one test per block, plus a share per triangle that
     /// keeps a large triangle out of a block of small ones. 1 for binary BVHs; the wide
     /// layouts build with 4, the triangles their leaves test at once, which ends the
-    /// binary tree at the leaves they will hold.
+    /// binary tree at the leaves they will hold. A power of two (others count as the next
+    /// one up).
     pub leaf_block: usize,
 }
 

@@ -104,19 +104,26 @@ struct Ctx {
     sah: SahCost,
     max_leaf: usize,
     bins: usize,
-    /// [`BuildOptions::leaf_block`].
+    /// [`BuildOptions::leaf_block`] (rounded up to a power of two) and its log: the sweep
+    /// counts blocks with a shift, where a division cost tens of cycles per plane.
     block: usize,
+    block_log: u32,
+    /// [`PER_TRIANGLE`] when counting in blocks, else 0.
+    per_triangle: f32,
 }
 
 impl Ctx {
+    fn new(method: SplitMethod, opts: &BuildOptions) -> Self {
+        let block = opts.leaf_block.max(1).next_power_of_two();
+        let per_triangle = if block > 1 { PER_TRIANGLE } else { 0.0 };
+        Ctx { method, sah: SahCost::from_options(opts), max_leaf: opts.max_leaf_size.max(1), bins: opts.bins.clamp(2, 256), block, block_log: block.trailing_zeros(), per_triangle }
+    }
+
     /// The tests a side of `n` primitives costs: `n`, or in blocks, one per block plus
     /// [`PER_TRIANGLE`] per triangle.
     #[inline]
     fn blocks(&self, n: usize) -> f32 {
-        if self.block == 1 {
-            return n as f32;
-        }
-        n.div_ceil(self.block) as f32 + PER_TRIANGLE * n as f32
+        ((n + self.block - 1) >> self.block_log) as f32 + self.per_triangle * n as f32
     }
 }
 
@@ -140,7 +147,7 @@ pub(super) fn build<P: Primitives + ?Sized>(prims: &P, method: SplitMethod, opts
             PrimRef::new(b.min.into(), b.max.into(), i)
         })
         .collect();
-    let ctx = Ctx { method, sah: SahCost::from_options(opts), max_leaf: opts.max_leaf_size.max(1), bins: opts.bins.clamp(2, 256), block: opts.leaf_block.max(1) };
+    let ctx = Ctx::new(method, opts);
     let extent = Extent::of(&refs);
     // The partitions' second array, allocated (and its pages touched, in parallel) once
     // rather than grown and faulted in at every large node.
@@ -305,23 +312,19 @@ impl Ctx {
         let pa = extent.geom.half_area();
         let flat = pa <= 0.0;
         let weight = |b: &Box3| if flat { 1.0 } else { b.half_area() };
-        let mut boxes = [Box3::EMPTY; TINY];
-        for (b, r) in boxes.iter_mut().zip(refs.iter()) {
-            *b = r.bounds();
+        // The union of every subset of the primitives, by its mask: each from the subset
+        // without its lowest member, with no branch on the masks' bits.
+        let mut union = [Box3::EMPTY; 1 << TINY];
+        for mask in 1..1usize << n {
+            let low = mask.trailing_zeros() as usize;
+            union[mask] = union[mask & (mask - 1)].union(refs[low].bounds());
         }
+        let all = (1usize << n) - 1;
         // The last primitive always on the right: each cut once.
-        let (mut best_x, mut best_mask) = (f32::INFINITY, 0u32);
-        for mask in 1..1u32 << (n - 1) {
-            let (mut l, mut r) = (Box3::EMPTY, Box3::EMPTY);
-            for (i, b) in boxes[..n].iter().enumerate() {
-                if mask >> i & 1 != 0 {
-                    l = l.union(*b);
-                } else {
-                    r = r.union(*b);
-                }
-            }
+        let (mut best_x, mut best_mask) = (f32::INFINITY, 0);
+        for mask in 1..1usize << (n - 1) {
             let nl = mask.count_ones() as usize;
-            let x = weight(&l) * self.blocks(nl) + weight(&r) * self.blocks(n - nl);
+            let x = weight(&union[mask]) * self.blocks(nl) + weight(&union[all ^ mask]) * self.blocks(n - nl);
             if x < best_x {
                 (best_x, best_mask) = (x, mask);
             }
@@ -330,11 +333,11 @@ impl Ctx {
         if best_cost >= self.sah.intersection * self.blocks(n) && n <= self.max_leaf {
             return None;
         }
-        let mut all = [refs[0]; TINY];
-        all[..n].copy_from_slice(refs);
+        let mut copy = [refs[0]; TINY];
+        copy[..n].copy_from_slice(refs);
         let left = |i: &usize| best_mask >> i & 1 != 0;
         for (to, i) in refs.iter_mut().zip((0..n).filter(left).chain((0..n).filter(|i| !left(i)))) {
-            *to = all[i];
+            *to = copy[i];
         }
         Some(halves(refs, best_mask.count_ones() as usize))
     }
