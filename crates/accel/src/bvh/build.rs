@@ -123,7 +123,9 @@ impl Ctx {
     /// [`PER_TRIANGLE`] per triangle.
     #[inline]
     fn blocks(&self, n: usize) -> f32 {
-        ((n + self.block - 1) >> self.block_log) as f32 + self.per_triangle * n as f32
+        // Through `u32` (counts stay below 2³⁰): converting a `usize` to a float costs a
+        // branch on its top bit without AVX-512.
+        ((n + self.block - 1) >> self.block_log) as u32 as f32 + self.per_triangle * n as u32 as f32
     }
 }
 
