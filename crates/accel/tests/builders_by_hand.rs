@@ -312,6 +312,14 @@ fn binned_sah_counts_in_blocks_for_the_wide_layouts() {
     assert_eq!(shape(&Bvh::build(&rows, SplitMethod::BinnedSah, &BuildOptions { leaf_block: 4, ..opts(1.0, 1.0, 2, 16) })), "(([0 1] [2 3]) ([4 5] [6 7]))");
 }
 
+/// The shape of the binned SAH's tree over `boxes`, counting in blocks of four.
+fn in_blocks(boxes: Vec<Aabb>) -> String {
+    let s = Boxes(boxes);
+    let b = Bvh::build(&s, SplitMethod::BinnedSah, &BuildOptions { leaf_block: 4, ..opts(1.0, 1.0, 8, 16) });
+    b.validate(&s).unwrap();
+    shape(&b)
+}
+
 #[test]
 fn binned_sah_in_blocks_splits_a_large_primitive_from_small_ones() {
     // A cube of side 10 at the origin (half area 300) and three cubes of side 0.1 at x = 4,
@@ -321,10 +329,7 @@ fn binned_sah_in_blocks_splits_a_large_primitive_from_small_ones() {
     // leaf whose one block every ray reaching the large cube would test; the per-triangle
     // share must exceed a third for the split to win (c(4) - c(1) > the traversal cost).
     // The three small ones stay a leaf: 2.05 against 1 + (0.03·1.35 + 0.07·1.7)/0.11 = 2.45.
-    let s = Boxes(vec![cube_at(0.0, 5.0), cube_at(4.0, 0.05), cube_at(4.2, 0.05), cube_at(4.4, 0.05)]);
-    let b = Bvh::build(&s, SplitMethod::BinnedSah, &BuildOptions { leaf_block: 4, ..opts(1.0, 1.0, 8, 16) });
-    b.validate(&s).unwrap();
-    assert_eq!(shape(&b), "(0 [1 2 3])");
+    assert_eq!(in_blocks(vec![cube_at(0.0, 5.0), cube_at(4.0, 0.05), cube_at(4.2, 0.05), cube_at(4.4, 0.05)]), "(0 [1 2 3])");
 }
 
 #[test]
@@ -336,10 +341,7 @@ fn binned_sah_in_blocks_tries_every_cut_of_four() {
     // make a leaf. Of every cut, {1} | {0, 2, 3} costs 1 + (300·1.35 + 0.15·2.05)/300 =
     // 2.351: a split. The small ones stay a leaf (2.05 against 2.06 and 2.52 for their
     // cuts).
-    let s = Boxes(vec![cube_at(0.8, 0.05), cube_at(1.0, 5.0), cube_at(1.2, 0.05), cube_at(1.4, 0.05)]);
-    let b = Bvh::build(&s, SplitMethod::BinnedSah, &BuildOptions { leaf_block: 4, ..opts(1.0, 1.0, 8, 16) });
-    b.validate(&s).unwrap();
-    assert_eq!(shape(&b), "(1 [0 2 3])");
+    assert_eq!(in_blocks(vec![cube_at(0.8, 0.05), cube_at(1.0, 5.0), cube_at(1.2, 0.05), cube_at(1.4, 0.05)]), "(1 [0 2 3])");
 }
 
 #[test]
