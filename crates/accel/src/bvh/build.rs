@@ -105,7 +105,7 @@ struct Ctx {
     max_leaf: usize,
     bins: usize,
     /// [`BuildOptions::leaf_block`] (rounded up to a power of two) and its log: the sweep
-    /// counts blocks with a shift, where a division cost tens of cycles per plane.
+    /// counts blocks with a shift instead of an integer division per plane.
     block: usize,
     block_log: u32,
     /// [`PER_TRIANGLE`] when counting in blocks, else 0.
