@@ -18,6 +18,8 @@ mod packet;
 pub mod quant;
 #[cfg(target_arch = "x86_64")]
 mod ray_major;
+#[cfg(target_arch = "x86_64")]
+mod ray_major_avx2;
 mod traverse;
 
 use rayon::prelude::*;
@@ -169,6 +171,19 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
         match self.packet_kernel {
             // SAFETY: `Kernel::Avx512` is only chosen after detecting its features.
             Kernel::Avx512 => return unsafe { packet_avx512::<P, W, N, COUNT>(self, prims, rays, out, c) },
+            Kernel::Simd if W == 8 && !rays.is_empty() && rays.len() <= PACKET && out.len() == rays.len() => {
+                // Ray-major in packets of eight (4×2 rays of a camera tile), as Embree on
+                // AVX2; a part whose rays do not share box rows and shear axes goes
+                // child-major.
+                for (rays, out) in rays.chunks(ray_major_avx2::RAYS).zip(out.chunks_mut(ray_major_avx2::RAYS)) {
+                    // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
+                    if !unsafe { ray_major_avx2::closest::<P, W, N, COUNT>(self, prims, rays, out, c) } {
+                        // SAFETY: as above.
+                        unsafe { packet_avx2::<P, W, N, COUNT>(self, prims, rays, out, c) };
+                    }
+                }
+                return;
+            }
             // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
             Kernel::Simd if W == 8 => return unsafe { packet_avx2::<P, W, N, COUNT>(self, prims, rays, out, c) },
             Kernel::Simd => return packet::closest::<P, W, N, true, COUNT>(self, prims, rays, out, c),

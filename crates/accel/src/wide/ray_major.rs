@@ -63,17 +63,17 @@ struct Packet {
 /// are monotone, so the slab arithmetic on the extreme origin and inverse of each axis
 /// bounds each ray's entry distance from below and exit distance from above; with finite
 /// constants no NaN arises.
-struct Frustum {
+pub(super) struct Frustum {
     /// Per axis, the origin giving the least near-plane difference `bound - origin` for
     /// rays along `+axis` (the greatest origin) and the greatest for rays along `-axis`.
-    near_origin: [f32; 3],
+    pub(super) near_origin: [f32; 3],
     /// The other extreme, for the far planes.
-    far_origin: [f32; 3],
+    pub(super) far_origin: [f32; 3],
     /// Per axis, the least and greatest inverse direction, and the same of `inv_far`.
-    inv: [[f32; 2]; 3],
-    inv_far: [[f32; 2]; 3],
+    pub(super) inv: [[f32; 2]; 3],
+    pub(super) inv_far: [[f32; 2]; 3],
     /// The least `t_min`.
-    t_min: f32,
+    pub(super) t_min: f32,
 }
 
 impl Packet {
@@ -392,7 +392,7 @@ pub(super) unsafe fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W
 /// Leaves that this many rays or fewer reach are tested ray by ray (each ray's four-wide
 /// triangle test): sixteen lanes for one ray cost more. Nodes are always tested in sixteen
 /// lanes: after the frustum test that is cheaper than ray by ray even for two rays.
-const FEW_IN_LEAF: u32 = 1;
+pub(super) const FEW_IN_LEAF: u32 = 1;
 
 /// The blocks of a leaf against the `active` rays one at a time, with the single-ray
 /// block test, from and into their best hits so far.
@@ -439,10 +439,10 @@ fn slabs<const W: usize>(node: &WideNode<W>, l: usize, p: &Packet, near_rows: [u
 
 /// The children of `node` that some ray of the packet may enter (a superset of those any
 /// ray's [`slabs`] enters, since `far` bounds every ray's limit) and a lower bound of their
-/// rays' entry distances.
+/// rays' entry distances. AVX2 alone: the 8-ray packets of `ray_major_avx2.rs` use it too.
 #[inline]
-#[target_feature(enable = "avx2,avx512f,avx512vl")]
-fn frustum_slabs(node: &WideNode<8>, f: &Frustum, near_rows: [usize; 3], far_rows: [usize; 3], far: f32) -> (u32, __m256) {
+#[target_feature(enable = "avx2")]
+pub(super) fn frustum_slabs(node: &WideNode<8>, f: &Frustum, near_rows: [usize; 3], far_rows: [usize; 3], far: f32) -> (u32, __m256) {
     let mut t0 = _mm256_set1_ps(f.t_min);
     let mut t1 = _mm256_set1_ps(far);
     let set = _mm256_set1_ps;
@@ -567,7 +567,7 @@ fn triangle(b: &TriBlock, j: usize, p: &Packet, (kx, ky, kz): (usize, usize, usi
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use raylab_core::{Pcg32, Ray, Vec3};
 
     use super::super::{node::WideNode, quant::QuantNode, WideBvh};
@@ -575,9 +575,16 @@ mod tests {
     use crate::{binary_for_wide, BuildOptions, Counters, PrimHit, Primitives};
 
     /// Triangles (through the packed blocks) then spheres (lanes that are not triangles).
-    struct Mixed {
-        tris: Vec<[Vec3; 3]>,
+    pub(in crate::wide) struct Mixed {
+        pub(in crate::wide) tris: Vec<[Vec3; 3]>,
         spheres: Vec<(Vec3, f32)>,
+    }
+
+    impl Mixed {
+        /// One triangle at `z = 2`, facing rays from the origin along `+z`.
+        pub(in crate::wide) fn one_triangle() -> Mixed {
+            Mixed { tris: vec![[Vec3::new(-1.0, -1.0, 2.0), Vec3::new(1.0, -1.0, 2.0), Vec3::new(0.0, 1.0, 2.0)]], spheres: vec![] }
+        }
     }
 
     impl Primitives for Mixed {
@@ -610,7 +617,7 @@ mod tests {
     /// Random small triangles, a grid of quads whose shared edges and vertices rays pass
     /// through, a triangle repeated under three indices (exact ties: the lowest index
     /// wins), zero-area triangles (the scalar kernel's cases), and spheres.
-    fn scene(rng: &mut Pcg32) -> Mixed {
+    pub(in crate::wide) fn scene(rng: &mut Pcg32) -> Mixed {
         let mut r = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0;
         let mut tris: Vec<[Vec3; 3]> = (0..600).map(|_| {
             let c = r();
@@ -633,7 +640,7 @@ mod tests {
 
     /// Packets of 1 to 16 rays from one origin in a narrow cone (a camera tile), some with
     /// a `t_min` above zero or a short `t_max`, and some through grid vertices exactly.
-    fn packets(rng: &mut Pcg32, prims: &Mixed) -> Vec<Vec<Ray>> {
+    pub(in crate::wide) fn packets(rng: &mut Pcg32, prims: &Mixed) -> Vec<Vec<Ray>> {
         (0..400).map(|k| {
             // Every eleventh packet leaves a point of a tilted triangle (hits at t within
             // the error bound of zero, some decided by the scalar kernel).
@@ -913,7 +920,7 @@ mod tests {
         if !(has!("avx512f") && has!("avx512vl") && has!("avx2") && has!("bmi1") && has!("bmi2")) {
             return;
         }
-        let prims = Mixed { tris: vec![[Vec3::new(-1.0, -1.0, 2.0), Vec3::new(1.0, -1.0, 2.0), Vec3::new(0.0, 1.0, 2.0)]], spheres: vec![] };
+        let prims = Mixed::one_triangle();
         let bvh = WideBvh::<8, WideNode<8>>::from_binary(&binary_for_wide(&prims, &BuildOptions::default(), "bvh"), &prims, "bvh8");
         let run = |dirs: &[Vec3]| {
             let rays: Vec<Ray> = dirs.iter().map(|&d| Ray::new(Vec3::ZERO, d)).collect();
