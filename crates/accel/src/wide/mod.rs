@@ -9,7 +9,9 @@
 //! - `kernels.rs`: box and triangle kernels, SIMD and portable with identical answers;
 //! - `traverse.rs`: closest and any hit, counting or not;
 //! - `packet.rs`: closest hits of 16-ray packets (4×4 tiles of camera rays), child-major;
-//! - `ray_major.rs`: the same with AVX-512, one ray per lane (Embree's `rtcIntersect16`).
+//! - `ray_major.rs`: the same with AVX-512, one ray per lane (Embree's `rtcIntersect16`);
+//! - `ray_major_avx2.rs`: the same with AVX2, eight rays per register (`rtcIntersect8`),
+//!   a 16-ray tile as two packets of eight.
 
 mod collapse;
 pub mod kernels;
@@ -37,7 +39,9 @@ pub use packet::PACKET;
 pub enum Kernel {
     /// Plain Rust, on any CPU.
     Portable,
-    /// `std::arch`: AVX2 for 8-wide nodes, SSE2 for 4-wide (x86-64 only).
+    /// `std::arch`: AVX2 for 8-wide nodes, SSE2 for 4-wide (x86-64 only). Packets of
+    /// 8-wide nodes go ray-major in halves of eight rays (`wide/ray_major_avx2.rs`), those
+    /// whose rays do not share box rows and shear axes child-major (`wide/packet.rs`).
     Simd,
     /// The same intrinsics with the whole traversal compiled for AVX-512F/VL: 32 vector
     /// registers instead of 16 and mask registers for the compares. Same IEEE operations
@@ -57,8 +61,8 @@ impl Kernel {
     }
 
     /// The default kernel of packets: [`Kernel::Avx512`] for 8-wide nodes where the CPU
-    /// runs it (ray-major packets, faster than the child-major ones of [`Kernel::Simd`]:
-    /// docs/performance.md, eleventh round), else that of single rays.
+    /// runs it (sixteen rays per register: docs/performance.md, eleventh round), else that
+    /// of single rays (with AVX2, eight rays per register: nineteenth round).
     pub fn detect_packets(w: usize) -> Kernel {
         if w == 8 { Kernel::Avx512.available(w) } else { Kernel::detect(w) }
     }

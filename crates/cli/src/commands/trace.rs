@@ -51,7 +51,7 @@ pub struct TraceArgs {
 pub enum KernelArg {
     Auto,
     Portable,
-    /// AVX2 for 8-wide nodes, SSE2 for 4-wide
+    /// AVX2 for 8-wide nodes, SSE2 for 4-wide; 8-wide packets ray-major, 8 rays per register
     Simd,
     /// The SIMD kernels compiled for AVX-512F/VL (32 vector registers); 8-wide packets ray-major, 16 rays per register
     Avx512,
