@@ -203,6 +203,66 @@ fn any_portable<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const COUN
     any::<P, W, N, false, COUNT>(bvh, prims, ray, c)
 }
 
+/// The children of interior node `cur` that the ray enters within `t_max`: pushes all but
+/// the nearest, far to near, and returns the nearest; `None` when it enters none.
+#[inline(always)]
+fn enter_closest<const W: usize, N: Layout<W>, const SIMD: bool>(bvh: &WideBvh<W, N>, cur: ChildRef, rb: &RayBoxes, t_max: f32, stack: &mut [MaybeUninit<Entry>; STACK], sp: &mut usize) -> Option<ChildRef> {
+    let node = &bvh.nodes[cur as usize];
+    let mut tnear = [0.0f32; W];
+    let mask = node.boxes::<SIMD>(rb, t_max * ROBUST_FAR, &mut tnear);
+    if mask == 0 {
+        return None;
+    }
+    let first = mask.trailing_zeros() as usize;
+    if mask & (mask - 1) == 0 {
+        return Some(node.child(first));
+    }
+    let rest = mask & (mask - 1);
+    if rest & (rest - 1) == 0 {
+        // Two children, the most frequent case after one: no sort, the same order as the
+        // keys below give.
+        let second = rest.trailing_zeros() as usize;
+        let key = |l: usize| (tnear[l].to_bits() & !(W as u32 - 1)) | l as u32;
+        let (near, far) = if key(second) < key(first) { (second, first) } else { (first, second) };
+        stack[*sp] = MaybeUninit::new(Entry { node: node.child(far), t: tnear[far] });
+        *sp += 1;
+        return Some(node.child(near));
+    }
+    // Sort the hit lanes by entry distance: keys are the distance's bits (in order for
+    // t >= 0) with the lane in the low bits.
+    let lane_bits = W as u32 - 1;
+    let mut keys = [0u32; W];
+    let mut n = 0;
+    let mut m = mask;
+    while m != 0 {
+        let l = m.trailing_zeros();
+        m &= m - 1;
+        insert_sorted(&mut keys, &mut n, (tnear[l as usize].to_bits() & !lane_bits) | l);
+    }
+    for &key in keys[1..n].iter().rev() {
+        let l = (key & lane_bits) as usize;
+        stack[*sp] = MaybeUninit::new(Entry { node: node.child(l), t: tnear[l] });
+        *sp += 1;
+    }
+    Some(node.child((keys[0] & lane_bits) as usize))
+}
+
+/// The next pushed node whose entry lies within `t_max` (the others are dropped without
+/// touching their memory); `None` when the stack runs out.
+#[inline(always)]
+fn pop_closest(stack: &[MaybeUninit<Entry>; STACK], sp: &mut usize, t_max: f32) -> Option<ChildRef> {
+    while *sp > 0 {
+        *sp -= 1;
+        // SAFETY: entries below `sp` were written by `enter_closest`.
+        let e = unsafe { stack[*sp].assume_init() };
+        // Widened as in the box test (see `boxes_portable`).
+        if e.t <= t_max * ROBUST_FAR {
+            return Some(e.node);
+        }
+    }
+    None
+}
+
 #[inline(always)]
 pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SIMD: bool, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
     // The per-ray constants are read from the caller's ray, not from the copy below: a
@@ -220,73 +280,44 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
     if bvh.root == EMPTY {
         return None;
     }
-    let s = ShearedRay::new(ray);
-    let br = BlockRay::new(&s);
-    let mut ray = *ray;
-    let mut best = None;
     let mut w = Work::default();
     let mut stack = [const { MaybeUninit::<Entry>::uninit() }; STACK];
     let mut sp = 0usize;
     let mut cur = bvh.root;
-    'walk: loop {
+    // Interior nodes down to the first leaf, without the block test's constants (two
+    // divisions and their spills): most camera rays miss the mesh and never need them.
+    while !is_leaf(cur) {
+        if COUNT {
+            w.nodes += 1;
+        }
+        match enter_closest::<W, N, SIMD>(bvh, cur, &rb, ray.t_max, &mut stack, &mut sp).or_else(|| pop_closest(&stack, &mut sp, ray.t_max)) {
+            Some(next) => cur = next,
+            None => {
+                if COUNT {
+                    c.nodes_visited += w.nodes;
+                }
+                return None;
+            }
+        }
+    }
+    let s = ShearedRay::new(ray);
+    let br = BlockRay::new(&s);
+    let mut ray = *ray;
+    let mut best = None;
+    loop {
         if COUNT {
             w.nodes += 1;
         }
         if is_leaf(cur) {
             leaf_closest::<P, SIMD, COUNT>(leaf_slice(bvh, cur), prims, &s, &br, &mut ray, &mut best, &mut w);
-        } else {
-            let node = &bvh.nodes[cur as usize];
-            let mut tnear = [0.0f32; W];
-            let mask = node.boxes::<SIMD>(&rb, ray.t_max * ROBUST_FAR, &mut tnear);
-            if mask != 0 {
-                let first = mask.trailing_zeros() as usize;
-                if mask & (mask - 1) == 0 {
-                    cur = node.child(first);
-                    continue 'walk;
-                }
-                let rest = mask & (mask - 1);
-                if rest & (rest - 1) == 0 {
-                    // Two children, the most frequent case after one: no sort, the same
-                    // order as the keys below give.
-                    let second = rest.trailing_zeros() as usize;
-                    let key = |l: usize| (tnear[l].to_bits() & !(W as u32 - 1)) | l as u32;
-                    let (near, far) = if key(second) < key(first) { (second, first) } else { (first, second) };
-                    stack[sp] = MaybeUninit::new(Entry { node: node.child(far), t: tnear[far] });
-                    sp += 1;
-                    cur = node.child(near);
-                    continue 'walk;
-                }
-                // Sort the hit lanes by entry distance: keys are the distance's bits (in
-                // order for t >= 0) with the lane in the low bits.
-                let lane_bits = W as u32 - 1;
-                let mut keys = [0u32; W];
-                let mut n = 0;
-                let mut m = mask;
-                while m != 0 {
-                    let l = m.trailing_zeros();
-                    m &= m - 1;
-                    insert_sorted(&mut keys, &mut n, (tnear[l as usize].to_bits() & !lane_bits) | l);
-                }
-                for &key in keys[1..n].iter().rev() {
-                    let l = (key & lane_bits) as usize;
-                    stack[sp] = MaybeUninit::new(Entry { node: node.child(l), t: tnear[l] });
-                    sp += 1;
-                }
-                cur = node.child((keys[0] & lane_bits) as usize);
-                continue 'walk;
-            }
+        } else if let Some(next) = enter_closest::<W, N, SIMD>(bvh, cur, &rb, ray.t_max, &mut stack, &mut sp) {
+            cur = next;
+            continue;
         }
-        while sp > 0 {
-            sp -= 1;
-            // SAFETY: entries below `sp` were written by the pushes above.
-            let e = unsafe { stack[sp].assume_init() };
-            // Widened as in the box test (see `boxes_portable`).
-            if e.t <= ray.t_max * ROBUST_FAR {
-                cur = e.node;
-                continue 'walk;
-            }
+        match pop_closest(&stack, &mut sp, ray.t_max) {
+            Some(next) => cur = next,
+            None => break,
         }
-        break;
     }
     if COUNT {
         c.nodes_visited += w.nodes;
