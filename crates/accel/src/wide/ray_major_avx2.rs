@@ -137,19 +137,19 @@ impl Packet {
         for (k, x) in origin.iter().chain(&shear).enumerate() {
             each[k].0 = lanes(*x);
         }
-        let (o, i, t) = (origin.map(|x| lanes(x)), inv.map(|x| lanes(x)), lanes(t_min));
-        let finite = |x: &[f32; RAYS]| x.iter().all(|v| v.is_finite());
-        let least = |x: &[f32; RAYS]| x.iter().copied().fold(f32::INFINITY, f32::min);
-        let most = |x: &[f32; RAYS]| x.iter().copied().fold(f32::NEG_INFINITY, f32::max);
-        let frustum = (o.iter().all(finite) && i.iter().all(finite) && inv_far.iter().all(|x| finite(&lanes(*x))) && finite(&t)).then(|| {
+        let inf = _mm256_set1_ps(f32::INFINITY);
+        let finite = |x: &__m256| bits(_mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_andnot_ps(sign, *x), inf)) == ALL;
+        let frustum = (origin.iter().chain(&inv).chain(&inv_far).all(finite) && finite(&t_min)).then(|| {
             let along = |a: usize, pos: f32, neg: f32| if negative[a] == 0 { pos } else { neg };
-            let inv = [0, 1, 2].map(|a| [least(&i[a]), most(&i[a])]);
+            let inv = inv.map(|i| [least_of(i), most_of(i)]);
             Frustum {
-                near_origin: [0, 1, 2].map(|a| along(a, most(&o[a]), least(&o[a]))),
-                far_origin: [0, 1, 2].map(|a| along(a, least(&o[a]), most(&o[a]))),
+                near_origin: [0, 1, 2].map(|a| along(a, most_of(origin[a]), least_of(origin[a]))),
+                far_origin: [0, 1, 2].map(|a| along(a, least_of(origin[a]), most_of(origin[a]))),
                 inv,
+                // Rounding is monotone: the extremes of `inv · ROBUST_FAR` are those of `inv`
+                // times it, as each lane computes it.
                 inv_far: inv.map(|[l, h]| [l * ROBUST_FAR, h * ROBUST_FAR]),
-                t_min: least(&t),
+                t_min: least_of(t_min),
             }
         });
         Some((Packet { origin, inv, inv_far, t_min, shear, near_rows, far_rows, axes: (kx, ky, kz), each, frustum }, t_max))
