@@ -637,6 +637,74 @@ mod tests {
         assert!(packets > 3000 && hits > 5000 && exact > 500, "too few cases: {packets} packets, {hits} hits, {exact} left to the scalar kernel");
     }
 
+    /// The frustum of eight rays keeps every child that any of them enters, with an entry
+    /// distance no greater than that ray's: random boxes (empty, flat, huge and tiny ones
+    /// among them) against packets over narrow and wide cones, some from scattered origins.
+    #[test]
+    fn the_frustum_of_eight_rays_keeps_every_child_they_enter() {
+        use super::super::kernels::{slabs_avx2, RayBoxes};
+        if !avx2() {
+            return;
+        }
+        let mut rng = Pcg32::new(17, 9);
+        let mut r = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0;
+        let (mut entered, mut culled, mut packets) = (0, 0, 0);
+        for k in 0..3000 {
+            let scale = [1.0, 1e-3, 1e4][k % 3];
+            let mut node = WideNode::<8>::EMPTY_NODE;
+            for l in 0..8 - k % 3 {
+                let (c, e) = (r() * 2.0 * scale, (r().abs() + Vec3::splat(if l == 3 { 0.0 } else { 0.01 })) * scale);
+                let e = if l == 2 { Vec3::new(e.x, 0.0, e.z) } else { e };
+                node.set(l, &raylab_core::Aabb::new(c - e, c + e), l as u32);
+            }
+            let origin = r() * 5.0 * scale;
+            let target = node.child_bounds(k % 5);
+            let aim = (target.min + target.max) * 0.5 - origin;
+            let spread = [0.01, 0.2, 1.0][k % 3] * aim.length();
+            let rays: Vec<Ray> = (0..RAYS).map(|q| {
+                let o = if k % 4 == 0 { origin + r() * 0.5 * scale } else { origin };
+                let mut ray = Ray::new(o, aim + Vec3::new((q % 4) as f32 - 1.5, (q / 4) as f32 - 0.5, 0.0) * spread * 0.1);
+                ray.t_min = if k % 5 == 0 { 0.1 * q as f32 } else { 0.0 };
+                ray.t_max = if k % 6 == 0 { 1.0 + q as f32 } else { f32::INFINITY };
+                ray
+            }).collect();
+            // SAFETY: AVX2 checked above.
+            let Some((p, t_max)) = (unsafe { super::Packet::new(&rays) }) else { continue };
+            let f = p.frustum.as_ref().expect("finite constants give a frustum");
+            packets += 1;
+            let far_each = t_max_far(t_max);
+            let far_max = far_each.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+            // SAFETY: as above.
+            let (kept, t0) = unsafe { super::super::ray_major::frustum_slabs(&node, f, p.near_rows, p.far_rows, far_max) };
+            // SAFETY: as above.
+            let bound = unsafe { super::lanes(t0) };
+            let mut any = 0u32;
+            for (q, &far_q) in far_each.iter().enumerate() {
+                // SAFETY: as above.
+                let (near, exit) = unsafe {
+                    let (n, x) = slabs_avx2(&node, &RayBoxes::new(&rays[q]), far_q);
+                    (super::lanes(n), super::lanes(x))
+                };
+                for l in 0..8 {
+                    if near[l] <= exit[l] {
+                        any |= 1 << l;
+                        assert!(kept & 1 << l != 0, "packet {k}: ray {q} enters child {l}, culled by the frustum");
+                        assert!(bound[l] <= near[l], "packet {k}: child {l}: frustum entry {} above ray {q}'s {}", bound[l], near[l]);
+                    }
+                }
+            }
+            entered += any.count_ones();
+            culled += (!kept & 0xFF).count_ones();
+        }
+        assert!(packets > 2000 && entered > 3000 && culled > 3000, "too few cases: {packets} packets, {entered} children entered, {culled} culled");
+    }
+
+    /// Each ray's far limit for box tests (`t_max · ROBUST_FAR`, as the walk computes it).
+    fn t_max_far(t_max: core::arch::x86_64::__m256) -> [f32; RAYS] {
+        // SAFETY: the callers checked AVX2.
+        unsafe { super::lanes(t_max) }.map(|t| t * super::ROBUST_FAR)
+    }
+
     /// The packet's constants, loaded by the transpose, are each ray's own (`RayBoxes::new`,
     /// `ShearedRay::new`) and their exact extremes, for packets of 1 to 8 rays (lanes past
     /// the count repeat the last ray).
