@@ -9,9 +9,9 @@
 //! - `kernels.rs`: box and triangle kernels, SIMD and portable with identical answers;
 //! - `traverse.rs`: closest and any hit, counting or not;
 //! - `packet.rs`: closest hits of 16-ray packets (4×4 tiles of camera rays), child-major;
-//! - `ray_major.rs`: the same with AVX-512, one ray per lane (Embree's `rtcIntersect16`);
-//! - `ray_major_avx2.rs`: the same with AVX2, eight rays per register (`rtcIntersect8`),
-//!   a 16-ray tile as two packets of eight.
+//! - `ray_major/`: the same ray-major, one ray per lane, in one walk generic over the
+//!   register width: sixteen rays with AVX-512 (Embree's `rtcIntersect16`), eight with
+//!   AVX2 (`rtcIntersect8`, a 16-ray tile as two packets of eight).
 
 mod collapse;
 pub mod kernels;
@@ -20,8 +20,6 @@ mod packet;
 pub mod quant;
 #[cfg(target_arch = "x86_64")]
 mod ray_major;
-#[cfg(target_arch = "x86_64")]
-mod ray_major_avx2;
 mod traverse;
 
 use rayon::prelude::*;
@@ -40,14 +38,14 @@ pub enum Kernel {
     /// Plain Rust, on any CPU.
     Portable,
     /// `std::arch`: AVX2 for 8-wide nodes, SSE2 for 4-wide (x86-64 only). Packets of
-    /// 8-wide nodes go ray-major in halves of eight rays (`wide/ray_major_avx2.rs`), those
+    /// 8-wide nodes go ray-major in halves of eight rays (`wide/ray_major/avx2.rs`), those
     /// whose rays do not share box rows and shear axes child-major (`wide/packet.rs`).
     Simd,
     /// The same intrinsics with the whole traversal compiled for AVX-512F/VL: 32 vector
     /// registers instead of 16 and mask registers for the compares. Same IEEE operations
     /// in the same order, so the same answers. Packets of 8-wide nodes whose rays share box
     /// rows and shear axes go ray-major, sixteen rays in the lanes of a 512-bit register
-    /// (`wide/ray_major.rs`). The default for such packets where the CPU runs it: see
+    /// (`wide/ray_major/avx512.rs`). The default for such packets where the CPU runs it: see
     /// [`Kernel::detect_packets`].
     Avx512,
 }
@@ -167,7 +165,7 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
         if W == 8 && self.packet_kernel == Kernel::Avx512 && !rays.is_empty() && rays.len() <= PACKET && out.len() == rays.len() && ray_major_available() {
             // SAFETY: the features were detected (`Kernel::Avx512` is only chosen after
             // detecting them, and `ray_major_available` checks them again).
-            if unsafe { ray_major::closest::<P, W, N, COUNT>(self, prims, rays, out, c) } {
+            if unsafe { ray_major::avx512::closest::<P, W, N, COUNT>(self, prims, rays, out, c) } {
                 return;
             }
         }
@@ -179,9 +177,9 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
                 // Ray-major in packets of eight (4×2 rays of a camera tile), as Embree on
                 // AVX2; a part whose rays do not share box rows and shear axes goes
                 // child-major.
-                for (rays, out) in rays.chunks(ray_major_avx2::RAYS).zip(out.chunks_mut(ray_major_avx2::RAYS)) {
+                for (rays, out) in rays.chunks(ray_major::avx2::RAYS).zip(out.chunks_mut(ray_major::avx2::RAYS)) {
                     // SAFETY: `Kernel::Simd` with W = 8 is only chosen after detecting AVX2.
-                    if !unsafe { ray_major_avx2::closest::<P, W, N, COUNT>(self, prims, rays, out, c) } {
+                    if !unsafe { ray_major::avx2::closest::<P, W, N, COUNT>(self, prims, rays, out, c) } {
                         // SAFETY: as above.
                         unsafe { packet_avx2::<P, W, N, COUNT>(self, prims, rays, out, c) };
                     }
@@ -292,7 +290,7 @@ fn encode<const W: usize, N: Layout<W>>(nodes: Vec<WideNode<W>>, root: ChildRef)
     out.into_iter().zip(&nodes).map(|(e, n)| e.unwrap_or_else(|| N::encode(n))).collect()
 }
 
-/// Whether this CPU runs the ray-major packet path ([`ray_major`]): AVX-512F and VL.
+/// Whether this CPU runs the 16-ray ray-major packet path (`ray_major/avx512.rs`): AVX-512F and VL.
 #[cfg(target_arch = "x86_64")]
 fn ray_major_available() -> bool {
     use std::is_x86_feature_detected as has;

@@ -86,7 +86,14 @@ pub trait Layout<const W: usize>: Copy + std::fmt::Debug + Send + Sync + 'static
     fn encode(node: &WideNode<W>) -> Self;
 
     /// Calls `f` with the f32 node this one decodes to: the boxes the box test uses.
-    fn with_decoded<R>(&self, f: impl FnOnce(&WideNode<W>) -> R) -> R;
+    #[inline(always)]
+    fn with_decoded<R>(&self, f: impl FnOnce(&WideNode<W>) -> R) -> R {
+        f(self.decoded(&mut std::mem::MaybeUninit::uninit()))
+    }
+
+    /// The f32 node this one decodes to: itself, or decoded into `scratch`. Without a
+    /// closure, for walks whose SIMD code must inline into their caller's target features.
+    fn decoded<'a>(&'a self, scratch: &'a mut std::mem::MaybeUninit<WideNode<W>>) -> &'a WideNode<W>;
 
     fn child(&self, lane: usize) -> ChildRef;
 
@@ -107,6 +114,11 @@ impl<const W: usize> Layout<W> for WideNode<W> {
     #[inline(always)]
     fn with_decoded<R>(&self, f: impl FnOnce(&WideNode<W>) -> R) -> R {
         f(self)
+    }
+
+    #[inline(always)]
+    fn decoded<'a>(&'a self, _: &'a mut std::mem::MaybeUninit<WideNode<W>>) -> &'a WideNode<W> {
+        self
     }
 
     #[inline(always)]

@@ -100,15 +100,15 @@ impl Layout<8> for QuantNode {
     }
 
     #[inline(always)]
-    fn with_decoded<R>(&self, f: impl FnOnce(&WideNode<8>) -> R) -> R {
-        let mut n = WideNode::<8>::EMPTY_NODE;
+    fn decoded<'a>(&'a self, scratch: &'a mut std::mem::MaybeUninit<WideNode<8>>) -> &'a WideNode<8> {
+        let n = scratch.write(WideNode::<8>::EMPTY_NODE);
         for l in (0..8).filter(|l| self.occupied & (1 << l) != 0) {
             for row in 0..6 {
                 n.bounds[row][l] = self.decode(row % 3, self.q[row][l]);
             }
             n.child[l] = self.child[l];
         }
-        f(&n)
+        n
     }
 
     #[inline(always)]
