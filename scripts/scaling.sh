@@ -10,6 +10,9 @@
 #           kernel on the bench's ray sets, alternated twice, into $OUT/kernels.tsv.
 # Writes each run's table (.md) and JSON to $OUT, and $OUT/render.tsv (scene, threads, wall s,
 # user s, whether the image is byte for byte the first thread count's).
+# The render sweep's scenes name their meshes, which the loader looks for in a `shared/scenes`
+# folder beside the checkout or above it (on a machine without ../shared, copy them into
+# `shared/scenes` in the checkout).
 # Settings (environment): RAYLAB (the binary; default: build target/release/raylab with
 # `--features peers,embree`, which needs Debian's libembree-dev, see scripts/peers.sh),
 # RAYLAB_SHARED (the shared `scenes` folder, default ../shared/scenes), OUT (default
