@@ -4,7 +4,7 @@ use raylab_core::{Ray, Vec3};
 
 use super::{Bvh, BvhNode};
 use crate::tree::{any_in_tree, closest_in_tree, TreeNode};
-use crate::wide::kernels::ROBUST_FAR;
+use crate::wide::ray::ROBUST_FAR;
 use crate::{Accel, AccelStats, Counters, Hit, Primitives, ValidationError};
 
 impl Accel for Bvh {

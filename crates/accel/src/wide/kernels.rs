@@ -6,65 +6,62 @@
 //! would change results — so both give bit-identical answers; the tests compare them.
 
 use raylab_core::intersect::ShearedRay;
-use raylab_core::{gamma, Ray};
 
-use super::node::{TriBlock, WideNode, EMPTY};
+use super::node::{ChildRef, Layout, TriBlock, WideNode, EMPTY};
+use super::ray::{BlockRay, RayBoxes};
 
-/// Far distances are scaled by `1 + 2γ₃` so that rounding never misses a box (pbrt-v4
-/// §6.8.2), as `Aabb::intersect` does.
-pub const ROBUST_FAR: f32 = 1.0 + 2.0 * gamma(3);
+/// The f32 node's boxes are tested by the kernels below, chosen by width: AVX2 for eight
+/// lanes, SSE2 for four, else the portable kernel.
+impl<const W: usize> Layout<W> for WideNode<W> {
+    const NAME: &'static str = "f32";
+    const EXACT: bool = true;
 
-/// Per-ray constants of the slab test.
-///
-/// The slab distances are computed as `(bound - origin) * inv_dir`, exactly as
-/// `Aabb::intersect` does, not as `bound * inv_dir - origin * inv_dir` with the product
-/// precomputed: that form (one FMA per slab in Embree) cancels catastrophically near the
-/// origin, where rays leaving a surface need the box test most, and with a zero direction
-/// component it computes `∞ - ∞`. One subtraction more per slab keeps pbrt's error bound.
-/// The far distances' widening by [`ROBUST_FAR`] is folded into their inverse
-/// (`inv_far`): the product `(bound - origin) · (inv · R)` carries the same four roundings
-/// as `((bound - origin) · inv) · R`, so the same bound, for one multiplication less.
-///
-/// The eight (or four) boxes' entry and exit distances are reduced over the three axes in
-/// integer order ([`boxes_portable`]): on a chain that every node visit waits for, a
-/// vector integer `max` takes one cycle where a float `max` takes four.
-#[derive(Clone, Copy, Debug)]
-pub struct RayBoxes {
-    pub origin: [f32; 3],
-    pub inv: [f32; 3],
-    /// `inv · ROBUST_FAR`.
-    pub inv_far: [f32; 3],
-    /// Row of [`WideNode::bounds`] giving the near (entry) plane of each axis: the min row
-    /// when the direction is positive, the max row when it is negative. This sorts the
-    /// slab distances once per ray instead of once per box.
-    pub near: [usize; 3],
-    pub far: [usize; 3],
-    /// `t_min`, with `-0` made `+0`.
-    pub t_min: f32,
-    /// Whether the slab distances are reduced in integer order ([`boxes_portable`]): the
-    /// ray starts at `t_min >= 0` and no distance can be NaN (a finite inverse direction;
-    /// a valid ray's origin is finite). Rays along an axis or reaching behind their origin
-    /// take the float test.
-    pub by_bits: bool,
-}
+    fn encode(node: &WideNode<W>) -> Self {
+        *node
+    }
 
-impl RayBoxes {
-    #[inline]
-    pub fn new(ray: &Ray) -> Self {
-        let inv = ray.inv_dir().to_array();
-        // Written without branches: a ray's direction signs are as good as random.
-        let neg = inv.map(|i| usize::from(i < 0.0));
-        let near = [0, 1, 2].map(|a| a + 3 * neg[a]);
-        let far = [0, 1, 2].map(|a| a + 3 - 3 * neg[a]);
-        // `-0 + 0 = +0`; every other value is unchanged.
-        let t_min = ray.t_min + 0.0;
-        let by_bits = (t_min >= 0.0) & inv[0].is_finite() & inv[1].is_finite() & inv[2].is_finite();
-        Self { origin: ray.origin.to_array(), inv, inv_far: inv.map(|i| i * ROBUST_FAR), near, far, t_min, by_bits }
+    #[inline(always)]
+    fn with_decoded<R>(&self, f: impl FnOnce(&WideNode<W>) -> R) -> R {
+        f(self)
+    }
+
+    #[inline(always)]
+    fn decoded<'a>(&'a self, _: &'a mut std::mem::MaybeUninit<WideNode<W>>) -> &'a WideNode<W> {
+        self
+    }
+
+    #[inline(always)]
+    fn child(&self, lane: usize) -> ChildRef {
+        self.child[lane]
+    }
+
+    #[inline(always)]
+    fn boxes<const SIMD: bool>(&self, r: &RayBoxes, t_max: f32, tnear: &mut [f32; W]) -> u32 {
+        child_boxes::<W, SIMD>(self, r, t_max, tnear)
     }
 }
 
+/// [`Layout::boxes`] of an f32 node: the SIMD kernel of its width, or the portable one.
+#[inline(always)]
+pub(super) fn child_boxes<const W: usize, const SIMD: bool>(node: &WideNode<W>, r: &RayBoxes, t_max: f32, tnear: &mut [f32; W]) -> u32 {
+    #[cfg(target_arch = "x86_64")]
+    if SIMD {
+        if W == 8 {
+            // SAFETY: `W == 8`, so these are the same types; SIMD = true with W = 8 is only
+            // instantiated inside functions with AVX2 enabled (`closest_avx2`, `closest_avx512`,
+            // ...) that `Kernel::available` selects after detecting their features.
+            return unsafe { boxes_avx2(&*(node as *const WideNode<W>).cast::<WideNode<8>>(), r, t_max, &mut *(tnear as *mut [f32; W]).cast::<[f32; 8]>()) };
+        }
+        if W == 4 {
+            // SAFETY: `W == 4`: the same types.
+            return unsafe { boxes_sse(&*(node as *const WideNode<W>).cast::<WideNode<4>>(), r, t_max, &mut *(tnear as *mut [f32; W]).cast::<[f32; 4]>()) };
+        }
+    }
+    boxes_portable(node, r, t_max, tnear)
+}
+
 /// Which children of `node` the ray enters within `[t_min, t_max]` (bit `l` for lane `l`)
-/// and their entry distances. Callers pass `t_max` already widened by [`ROBUST_FAR`]:
+/// and their entry distances. Callers pass `t_max` already widened by [`ROBUST_FAR`](super::ray::ROBUST_FAR):
 /// the entry distance of a flat box (coplanar triangles) may round a few ulps above the
 /// distance the triangle kernel computes for a hit inside it, and such a box must not be
 /// culled by that hit. A NaN slab distance (a ray lying in a slab's plane, `0 · ∞`)
@@ -268,25 +265,6 @@ pub fn triangles_sse(b: &TriBlock, s: &ShearedRay, t_min: f32, t_max: f32) -> Bl
     triangles_sse_for(b, &BlockRay::new(s), t_min, t_max)
 }
 
-/// A [`ShearedRay`]'s constants in the order the block test reads them, picked once per
-/// ray: the origin's components along the shear axes `kx`, `ky`, `kz`, the shear, and the
-/// axes. (Picking `origin[kx]` per block took about a fifth of a missed block's
-/// instructions: a run-time index into a `Vec3` is a chain of branches.)
-#[derive(Clone, Copy, Debug)]
-pub struct BlockRay {
-    pub origin: [f32; 3],
-    pub shear: [f32; 3],
-    pub axes: [usize; 3],
-}
-
-impl BlockRay {
-    #[inline(always)]
-    pub fn new(s: &ShearedRay) -> Self {
-        let o = s.origin.to_array();
-        Self { origin: [o[s.kx], o[s.ky], o[s.kz]], shear: [s.sx, s.sy, s.sz], axes: [s.kx, s.ky, s.kz] }
-    }
-}
-
 /// [`triangles_sse`] with the ray's constants picked already ([`BlockRay`]).
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
@@ -419,6 +397,8 @@ fn behind_for_sure(det: std::arch::x86_64::__m128, t_scaled: std::arch::x86_64::
 pub(super) mod tests {
     use super::*;
     use crate::wide::node::WideNode;
+    use crate::wide::ray::ROBUST_FAR;
+    use raylab_core::Ray;
     use raylab_core::{Aabb, Vec3};
 
     fn node8() -> WideNode<8> {

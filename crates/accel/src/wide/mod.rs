@@ -6,7 +6,9 @@
 //! - `node.rs`: the memory layout and its byte budget, and the [`Layout`] of a node's boxes;
 //! - `quant.rs`: the quantised 8-wide node (`bvh8q`, 96 bytes instead of 224);
 //! - `collapse.rs`: binary → wide, by a cost-driven programme (Ylitie et al. 2017);
-//! - `kernels.rs`: box and triangle kernels, SIMD and portable with identical answers;
+//! - `ray.rs`: the per-ray constants of the kernels, computed once per ray;
+//! - `kernels.rs`: box and triangle kernels, SIMD and portable with identical answers, and
+//!   the f32 node's [`Layout`];
 //! - `traverse.rs`: closest and any hit, counting or not;
 //! - `packet.rs`: closest hits of 16-ray packets (4×4 tiles of camera rays), child-major;
 //! - `ray_major/`: the same ray-major, one ray per lane, in one walk generic over the
@@ -18,6 +20,7 @@ pub mod kernels;
 pub mod node;
 mod packet;
 pub mod quant;
+pub mod ray;
 #[cfg(target_arch = "x86_64")]
 mod ray_major;
 mod traverse;

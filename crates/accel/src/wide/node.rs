@@ -5,7 +5,7 @@
 
 use raylab_core::{Aabb, Vec3};
 
-use super::kernels::RayBoxes;
+use super::ray::RayBoxes;
 
 /// A child slot's reference: an interior node index, or [`LEAF`] with a range of
 /// [`TriBlock`]s, or [`EMPTY`].
@@ -101,35 +101,6 @@ pub trait Layout<const W: usize>: Copy + std::fmt::Debug + Send + Sync + 'static
     /// their entry distances: the same answer as [`boxes_portable`](super::kernels::boxes_portable)
     /// on the decoded node, with SIMD or without.
     fn boxes<const SIMD: bool>(&self, r: &RayBoxes, t_max: f32, tnear: &mut [f32; W]) -> u32;
-}
-
-impl<const W: usize> Layout<W> for WideNode<W> {
-    const NAME: &'static str = "f32";
-    const EXACT: bool = true;
-
-    fn encode(node: &WideNode<W>) -> Self {
-        *node
-    }
-
-    #[inline(always)]
-    fn with_decoded<R>(&self, f: impl FnOnce(&WideNode<W>) -> R) -> R {
-        f(self)
-    }
-
-    #[inline(always)]
-    fn decoded<'a>(&'a self, _: &'a mut std::mem::MaybeUninit<WideNode<W>>) -> &'a WideNode<W> {
-        self
-    }
-
-    #[inline(always)]
-    fn child(&self, lane: usize) -> ChildRef {
-        self.child[lane]
-    }
-
-    #[inline(always)]
-    fn boxes<const SIMD: bool>(&self, r: &RayBoxes, t_max: f32, tnear: &mut [f32; W]) -> u32 {
-        super::traverse::child_boxes::<W, SIMD>(self, r, t_max, tnear)
-    }
 }
 
 /// Up to four triangles, vertices in SoA form (`p[vertex][axis][lane]`), copied from the

@@ -15,10 +15,10 @@ use raylab_core::intersect::ShearedRay;
 use raylab_core::Ray;
 
 #[cfg(target_arch = "x86_64")]
-use super::kernels::{slabs_avx2, slabs_of_rows_avx2};
-use super::kernels::{BlockRay, RayBoxes, ROBUST_FAR};
+use super::kernels::{child_boxes, slabs_avx2, slabs_of_rows_avx2};
+use super::ray::{BlockRay, RayBoxes, ROBUST_FAR};
 use super::node::{is_leaf, ChildRef, Layout, TriBlock, WideNode, EMPTY};
-use super::traverse::{block_closest, child_boxes, insert_sorted, leaf_slice, occupied, STACK};
+use super::traverse::{block_closest, insert_sorted, leaf_slice, occupied, STACK};
 use super::WideBvh;
 use crate::{Counters, Hit, Primitives};
 

@@ -11,7 +11,7 @@
 //! boxes only grow, so no hit is lost, and the portable and AVX2 kernels decode to the same
 //! bits.
 
-use super::kernels::RayBoxes;
+use super::ray::RayBoxes;
 use super::node::{ChildRef, Layout, WideNode, EMPTY};
 
 /// Eight children's boxes quantised on the node's grid: 96 bytes.

@@ -12,9 +12,10 @@ use std::mem::MaybeUninit;
 use raylab_core::intersect::ShearedRay;
 use raylab_core::Ray;
 
-use super::kernels::{boxes_portable, triangle_candidates, BlockRay, RayBoxes, ROBUST_FAR};
+use super::kernels::triangle_candidates;
+use super::ray::{BlockRay, RayBoxes, ROBUST_FAR};
 
-use super::node::{is_leaf, leaf_blocks, ChildRef, Layout, TriBlock, WideNode, EMPTY};
+use super::node::{is_leaf, leaf_blocks, ChildRef, Layout, TriBlock, EMPTY};
 use super::WideBvh;
 use crate::{Counters, Hit, PrimHit, Primitives};
 
@@ -34,24 +35,6 @@ struct Entry {
 struct Work {
     nodes: u64,
     tests: u64,
-}
-
-#[inline(always)]
-pub(super) fn child_boxes<const W: usize, const SIMD: bool>(node: &WideNode<W>, r: &RayBoxes, t_max: f32, tnear: &mut [f32; W]) -> u32 {
-    #[cfg(target_arch = "x86_64")]
-    if SIMD {
-        if W == 8 {
-            // SAFETY: `W == 8`, so these are the same types; SIMD = true with W = 8 is only
-            // instantiated inside functions with AVX2 enabled (`closest_avx2`, `closest_avx512`,
-            // ...) that `Kernel::available` selects after detecting their features.
-            return unsafe { super::kernels::boxes_avx2(&*(node as *const WideNode<W>).cast::<WideNode<8>>(), r, t_max, &mut *(tnear as *mut [f32; W]).cast::<[f32; 8]>()) };
-        }
-        if W == 4 {
-            // SAFETY: `W == 4`: the same types.
-            return unsafe { super::kernels::boxes_sse(&*(node as *const WideNode<W>).cast::<WideNode<4>>(), r, t_max, &mut *(tnear as *mut [f32; W]).cast::<[f32; 4]>()) };
-        }
-    }
-    boxes_portable(node, r, t_max, tnear)
 }
 
 /// Whether a hit at `t` on `prim`, found with `t <= ray.t_max` (the current best's

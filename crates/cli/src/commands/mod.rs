@@ -1,6 +1,5 @@
 pub mod bake;
 pub mod bench;
-pub mod bench_peers;
 pub mod compare;
 pub mod converge;
 pub mod gen;

@@ -57,7 +57,7 @@ use std::mem::MaybeUninit;
 use raylab_core::intersect::ShearedRay;
 use raylab_core::{gamma, Ray};
 
-use super::kernels::{BlockRay, ROBUST_FAR};
+use super::ray::{BlockRay, ROBUST_FAR};
 use super::node::{is_leaf, Layout, TriBlock, WideNode, EMPTY};
 use super::packet::prefetch;
 use super::traverse::{block_closest, exact_lane, insert_sorted, leaf_slice, occupied, wins, STACK};

@@ -227,7 +227,8 @@ fn the_triangle_kernel_matches_the_four_wide_kernel_ray_by_ray() {
 /// distance no greater than that ray's: random boxes (empty, flat, huge and tiny ones
 /// among them) against packets over narrow and wide cones, some from scattered origins.
 fn frustum_keeps<V: Vector>(v: V) {
-    use crate::wide::kernels::{slabs_avx2, RayBoxes};
+    use crate::wide::kernels::slabs_avx2;
+    use crate::wide::ray::RayBoxes;
     use std::arch::x86_64::*;
     let mut rng = Pcg32::new(17, 9);
     let mut r = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0;
@@ -297,7 +298,7 @@ fn the_frustum_keeps_every_child_a_ray_enters() {
 /// (`RayBoxes::new`, `ShearedRay::new`) and their exact extremes, for packets of 1 to
 /// the width's rays (lanes past the count repeat the last ray).
 fn constants<V: Vector>(v: V) {
-    use crate::wide::kernels::RayBoxes;
+    use crate::wide::ray::RayBoxes;
     use raylab_core::intersect::ShearedRay;
     let mut rng = Pcg32::new(3, 9);
     let mut f = |s: f32| (rng.next_f32() - 0.5) * s;

@@ -1,7 +1,10 @@
 //! `raylab bench`: every chosen structure on the same rays, side by side. The method (shared
 //! rays, oracle, interleaved timed passes, medians) is the lab's (`raylab_lab::sweep`); this
 //! command parses options, shows progress, runs the whole job list or one shard of it, merges
-//! shards, and writes the files.
+//! shards, and writes the files. `--peers` runs `peers.rs` instead: raylab against Embree,
+//! obvhs and the `bvh` crate on the same rays.
+
+mod peers;
 
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -99,7 +102,7 @@ impl Progress for Terminal {
 
 pub fn run(a: &BenchArgs) -> Result<()> {
     if let Some(peers) = &a.peers {
-        return super::bench_peers::run(a, peers);
+        return peers::run(a, peers);
     }
     // The outputs are checked before the (long) benchmark, not after it.
     for p in a.json.iter().chain(&a.report) {

@@ -20,7 +20,7 @@ use raylab_peers::table::{self, Clock, Row, Speed};
 use raylab_peers::{agree, Peer, PeerHit, PeerKind, RaylabPeer};
 use serde::Serialize;
 
-use super::bench::BenchArgs;
+use super::BenchArgs;
 
 /// The name of the packet ray set: the primary rays in 4×4 tiles, 16 rays per call for
 /// structures with a packet kernel (Embree's `rtcIntersect16`), one by one for the others.
