@@ -39,14 +39,16 @@ pub struct ShearedRay {
 impl ShearedRay {
     #[inline]
     pub fn new(ray: &Ray) -> Self {
-        // Selections rather than branches (a ray's direction is as good as random) and
-        // indices into an array rather than into a `Vec3` (a chain of branches).
-        let d = ray.dir.to_array();
+        // Selections rather than branches (a ray's direction is as good as random), and
+        // indices into the ray's own components rather than into a `Vec3` (a chain of
+        // branches) or a table (stored to the stack for every ray).
+        let d: &[f32; 3] = ray.dir.as_ref();
         let ad = d.map(f32::abs);
         // The axis of the largest |d|, ties to the later axis, as before.
         let (m, xy) = if ad[0] > ad[1] { (ad[0], 0) } else { (ad[1], 1) };
         let kz = if m > ad[2] { xy } else { 2 };
-        let (kx, ky) = ([1, 2, 0][kz], [2, 0, 1][kz]);
+        // The next two axes in cyclic order, swapped when the ray runs along -kz.
+        let (kx, ky) = (if kz == 2 { 0 } else { kz + 1 }, if kz == 0 { 2 } else { kz - 1 });
         let (kx, ky) = if d[kz] < 0.0 { (ky, kx) } else { (kx, ky) };
         Self { origin: ray.origin, kx, ky, kz, sx: d[kx] / d[kz], sy: d[ky] / d[kz], sz: 1.0 / d[kz] }
     }

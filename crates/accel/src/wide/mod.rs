@@ -76,7 +76,9 @@ impl Kernel {
             if self == Kernel::Avx512 && has!("avx512f") && has!("avx512vl") && has!("avx2") && has!("bmi1") && has!("bmi2") {
                 return Kernel::Avx512;
             }
-            if self != Kernel::Portable && (w == 4 || (w == 8 && has!("avx2"))) {
+            // The 8-wide walks use BMI's `tzcnt` and `blsr` on hit masks too: every CPU with
+            // AVX2 has them, but they are separate features.
+            if self != Kernel::Portable && (w == 4 || (w == 8 && has!("avx2") && has!("bmi1") && has!("bmi2"))) {
                 return Kernel::Simd;
             }
         }
@@ -301,9 +303,9 @@ fn ray_major_available() -> bool {
 }
 
 /// The AVX2 instantiations: the whole traversal is compiled with AVX2 so that the box
-/// kernel inlines into it.
+/// kernel inlines into it, and single rays with BMI (mask loops in `tzcnt` and `blsr`).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,bmi1,bmi2")]
 unsafe fn closest_avx2<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
     traverse::closest::<P, W, N, true, COUNT>(bvh, prims, ray, c)
 }
@@ -315,7 +317,7 @@ unsafe fn packet_avx2<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
 }
 
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,bmi1,bmi2")]
 unsafe fn any_avx2<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
     traverse::any::<P, W, N, true, COUNT>(bvh, prims, ray, c)
 }

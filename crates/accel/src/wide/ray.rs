@@ -72,7 +72,7 @@ pub struct BlockRay {
 impl BlockRay {
     #[inline(always)]
     pub fn new(s: &ShearedRay) -> Self {
-        let o = s.origin.to_array();
+        let o: &[f32; 3] = s.origin.as_ref();
         Self { origin: [o[s.kx], o[s.ky], o[s.kz]], shear: [s.sx, s.sy, s.sz], axes: [s.kx, s.ky, s.kz] }
     }
 }
