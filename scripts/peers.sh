@@ -3,7 +3,8 @@
 # (issue 11; docs/performance.md, "Peers, side by side"). From a clean clone:
 #   1. installs Debian's libembree-dev when its header is missing (as root, or with sudo);
 #   2. builds raylab with the peers (`--features peers,embree`, the release profile);
-#   3. runs `raylab bench --peers embree,obvhs,bvh` on bunny 69k, dragon 202k and 871k and
+#   3. runs `raylab bench --peers embree,obvhs,bvh` (Embree HIGH, MEDIUM and HIGH with
+#      RTC_SCENE_FLAG_ROBUST) on bunny 69k, dragon 202k and 871k and
 #      a procedural Sierpinski tetrahedron of 4.2M triangles (`raylab gen tetra --size 10`),
 #      for 1 and 2 threads, writing each run's tables (.md) and JSON to $OUT.
 # Settings (environment): RAYLAB_SHARED (the shared `scenes` folder, default

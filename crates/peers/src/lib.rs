@@ -68,6 +68,10 @@ pub enum PeerKind {
     Embree,
     /// Embree 3, build quality MEDIUM: built for its build time and memory, not traced.
     EmbreeMedium,
+    /// Embree 3, build quality HIGH with the scene flag `RTC_SCENE_FLAG_ROBUST`: box tests
+    /// that rounding cannot make miss and watertight triangle tests, the guarantees of
+    /// raylab's kernels.
+    EmbreeRobust,
     /// obvhs's compressed wide BVH (Ylitie et al. 2017), `medium_build` preset.
     ObvhsCwbvh,
     /// obvhs's binary BVH, `medium_build` preset.
@@ -81,6 +85,7 @@ impl PeerKind {
         match self {
             PeerKind::Embree => "embree",
             PeerKind::EmbreeMedium => "embree-medium",
+            PeerKind::EmbreeRobust => "embree-robust",
             PeerKind::ObvhsCwbvh => "obvhs-cwbvh",
             PeerKind::ObvhsBvh2 => "obvhs-bvh2",
             PeerKind::BvhCrate => "bvh-crate",
@@ -91,7 +96,7 @@ impl PeerKind {
     /// crate's `obvhs` and `bvh`).
     pub fn feature(self) -> &'static str {
         match self {
-            PeerKind::Embree | PeerKind::EmbreeMedium => "embree",
+            PeerKind::Embree | PeerKind::EmbreeMedium | PeerKind::EmbreeRobust => "embree",
             PeerKind::ObvhsCwbvh | PeerKind::ObvhsBvh2 | PeerKind::BvhCrate => "peers",
         }
     }
@@ -99,7 +104,7 @@ impl PeerKind {
     /// Whether this build of raylab has the peer.
     pub fn available(self) -> bool {
         match self {
-            PeerKind::Embree | PeerKind::EmbreeMedium => cfg!(feature = "embree"),
+            PeerKind::Embree | PeerKind::EmbreeMedium | PeerKind::EmbreeRobust => cfg!(feature = "embree"),
             PeerKind::ObvhsCwbvh | PeerKind::ObvhsBvh2 => cfg!(feature = "obvhs"),
             PeerKind::BvhCrate => cfg!(feature = "bvh"),
         }
@@ -113,7 +118,7 @@ impl PeerKind {
 
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum PeerError {
-    #[error("--peers: unknown peer `{0}` (expected embree, obvhs, bvh, or one of embree-medium, obvhs-cwbvh, obvhs-bvh2, bvh-crate)")]
+    #[error("--peers: unknown peer `{0}` (expected embree, obvhs, bvh, or one of embree-medium, embree-robust, obvhs-cwbvh, obvhs-bvh2, bvh-crate)")]
     Unknown(String),
     #[error("--peers: `{peer}` is not in this build of raylab; build it with `cargo build --release -p raylab --features {feature}` (scripts/peers.sh installs libembree-dev and runs the whole comparison)")]
     NotBuilt { peer: &'static str, feature: &'static str },
@@ -123,16 +128,18 @@ pub enum PeerError {
     NotATriangle(u32),
 }
 
-/// Parses a comma-separated `--peers` list: `embree` stands for HIGH and MEDIUM, `obvhs`
+/// Parses a comma-separated `--peers` list: `embree` stands for HIGH, MEDIUM and HIGH
+/// robust, `obvhs`
 /// for CWBVH and BVH2, `bvh` for the `bvh` crate. Every named peer must be in this build.
 pub fn parse_list(list: &str) -> Result<Vec<PeerKind>, PeerError> {
     let mut out = Vec::new();
     for name in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let kinds: &[PeerKind] = match name {
-            "embree" => &[PeerKind::Embree, PeerKind::EmbreeMedium],
+            "embree" => &[PeerKind::Embree, PeerKind::EmbreeMedium, PeerKind::EmbreeRobust],
             "obvhs" => &[PeerKind::ObvhsCwbvh, PeerKind::ObvhsBvh2],
             "bvh" | "bvh-crate" => &[PeerKind::BvhCrate],
             "embree-medium" => &[PeerKind::EmbreeMedium],
+            "embree-robust" => &[PeerKind::EmbreeRobust],
             "obvhs-cwbvh" => &[PeerKind::ObvhsCwbvh],
             "obvhs-bvh2" => &[PeerKind::ObvhsBvh2],
             _ => return Err(PeerError::Unknown(name.to_string())),
@@ -161,6 +168,8 @@ pub fn build(kind: PeerKind, tris: &[[Vec3; 3]], threads: usize) -> Result<Box<d
         PeerKind::Embree => Ok(Box::new(embree::EmbreePeer::build(tris, threads, embree::Quality::High)?)),
         #[cfg(feature = "embree")]
         PeerKind::EmbreeMedium => Ok(Box::new(embree::EmbreePeer::build(tris, threads, embree::Quality::Medium)?)),
+        #[cfg(feature = "embree")]
+        PeerKind::EmbreeRobust => Ok(Box::new(embree::EmbreePeer::build(tris, threads, embree::Quality::HighRobust)?)),
         #[cfg(feature = "obvhs")]
         PeerKind::ObvhsCwbvh => Ok(Box::new(obvhs_peer::ObvhsPeer::build_cwbvh(tris))),
         #[cfg(feature = "obvhs")]
@@ -179,7 +188,7 @@ mod tests {
     #[test]
     fn lists_expand_and_missing_features_say_how_to_build() {
         assert_eq!(parse_list("nope"), Err(PeerError::Unknown("nope".into())));
-        let all = [PeerKind::Embree, PeerKind::EmbreeMedium, PeerKind::ObvhsCwbvh, PeerKind::ObvhsBvh2, PeerKind::BvhCrate];
+        let all = [PeerKind::Embree, PeerKind::EmbreeMedium, PeerKind::EmbreeRobust, PeerKind::ObvhsCwbvh, PeerKind::ObvhsBvh2, PeerKind::BvhCrate];
         if all.iter().all(|k| k.available()) {
             assert_eq!(parse_list("embree,obvhs,bvh").unwrap(), all.to_vec());
             assert_eq!(parse_list("obvhs-cwbvh, obvhs").unwrap(), vec![PeerKind::ObvhsCwbvh, PeerKind::ObvhsBvh2]);

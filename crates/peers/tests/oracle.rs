@@ -10,7 +10,7 @@ use raylab_peers::{agree, harness, PeerKind, RaylabPeer, PACKET};
 use raylab_testkit::{asset, random_rays, read_obj_triangles};
 
 fn kinds() -> Vec<PeerKind> {
-    [PeerKind::Embree, PeerKind::EmbreeMedium, PeerKind::ObvhsCwbvh, PeerKind::ObvhsBvh2, PeerKind::BvhCrate].into_iter().filter(|k| k.available()).collect()
+    [PeerKind::Embree, PeerKind::EmbreeMedium, PeerKind::EmbreeRobust, PeerKind::ObvhsCwbvh, PeerKind::ObvhsBvh2, PeerKind::BvhCrate].into_iter().filter(|k| k.available()).collect()
 }
 
 #[test]

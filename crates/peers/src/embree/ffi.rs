@@ -19,6 +19,7 @@ pub const RTC_FORMAT_UINT3: i32 = 0x5003;
 pub const RTC_FORMAT_FLOAT3: i32 = 0x9003;
 pub const RTC_BUILD_QUALITY_MEDIUM: i32 = 1;
 pub const RTC_BUILD_QUALITY_HIGH: i32 = 2;
+pub const RTC_SCENE_FLAG_ROBUST: i32 = 1 << 2;
 pub const RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT: u32 = 0;
 pub const RTC_INTERSECT_CONTEXT_FLAG_COHERENT: u32 = 1;
 pub const RTC_ERROR_NONE: i32 = 0;
@@ -139,6 +140,7 @@ extern "C" {
     pub fn rtcNewScene(device: RTCDevice) -> RTCScene;
     pub fn rtcReleaseScene(scene: RTCScene);
     pub fn rtcSetSceneBuildQuality(scene: RTCScene, quality: i32);
+    pub fn rtcSetSceneFlags(scene: RTCScene, flags: i32);
     pub fn rtcCommitScene(scene: RTCScene);
     pub fn rtcNewGeometry(device: RTCDevice, kind: i32) -> RTCGeometry;
     pub fn rtcReleaseGeometry(geometry: RTCGeometry);

@@ -1,7 +1,9 @@
 //! Intel Embree 3 (Debian's `libembree-dev`) through the hand-written FFI of [`ffi`]: one
 //! device per structure configured with `threads=N` (and what `RAYLAB_EMBREE_CONFIG` adds), one triangle-mesh geometry with an
 //! indexed vertex buffer (shared vertices merged, as an application hands Embree a mesh),
-//! the scene built at quality HIGH (spatial splits) or MEDIUM. Rays are traced with
+//! the scene built at quality HIGH (spatial splits) or MEDIUM, and at HIGH with the scene
+//! flag `RTC_SCENE_FLAG_ROBUST` (box tests that rounding cannot make miss and watertight
+//! triangle tests: the guarantees raylab's kernels give, at their price). Rays are traced with
 //! `rtcIntersect1` / `rtcOccluded1` from raylab's rayon workers, and primary packets with
 //! `rtcIntersect16`. Memory is what Embree's memory monitor reports as held after the
 //! build: its BVH, its triangle leaves and the buffers it keeps.
@@ -22,6 +24,8 @@ use ffi::*;
 pub enum Quality {
     High,
     Medium,
+    /// HIGH with `RTC_SCENE_FLAG_ROBUST`.
+    HighRobust,
 }
 
 pub struct EmbreePeer {
@@ -91,12 +95,15 @@ impl EmbreePeer {
             rtcSetDeviceMemoryMonitorFunction(device, Some(monitor), &*bytes as *const AtomicIsize as *mut c_void);
             let mut peer = Self { device, scene: std::ptr::null_mut(), quality, build_ms: 0.0, bytes };
             let q = match quality {
-                Quality::High => RTC_BUILD_QUALITY_HIGH,
+                Quality::High | Quality::HighRobust => RTC_BUILD_QUALITY_HIGH,
                 Quality::Medium => RTC_BUILD_QUALITY_MEDIUM,
             };
             let start = Instant::now();
             peer.scene = rtcNewScene(device);
             rtcSetSceneBuildQuality(peer.scene, q);
+            if quality == Quality::HighRobust {
+                rtcSetSceneFlags(peer.scene, RTC_SCENE_FLAG_ROBUST);
+            }
             let geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
             rtcSetGeometryBuildQuality(geometry, q);
             let v = rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 12, vertices.len()) as *mut [f32; 3];
@@ -136,6 +143,7 @@ impl Peer for EmbreePeer {
         match self.quality {
             Quality::High => "embree high".into(),
             Quality::Medium => "embree medium".into(),
+            Quality::HighRobust => "embree high robust".into(),
         }
     }
     fn build_ms(&self) -> f64 {

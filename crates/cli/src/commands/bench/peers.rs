@@ -27,6 +27,9 @@ use super::BenchArgs;
 const PACKETS: &str = "primary16";
 /// The structure the ratios are taken to.
 const REFERENCE: &str = "embree high";
+/// Embree with the guarantees raylab's kernels give (box tests that rounding cannot make
+/// miss, watertight triangles): the second reference, for the price of those guarantees.
+const ROBUST: &str = "embree high robust";
 
 #[derive(Serialize)]
 struct PeersReport {
@@ -69,6 +72,8 @@ struct KindFigures {
     speed: Speed,
     /// Ratio to Embree HIGH by CPU time, when Embree ran.
     ratio_to_embree: Option<f64>,
+    /// Ratio to Embree HIGH with `RTC_SCENE_FLAG_ROBUST` by CPU time, when it ran.
+    ratio_to_embree_robust: Option<f64>,
     agreement: agree::Agreement,
 }
 
@@ -239,6 +244,10 @@ fn bench_scene(a: &BenchArgs, path: Option<&PathBuf>, accels: &[AccelKind], peer
     }
     println!("\nMrays/s per CPU second (ratio to {REFERENCE}):\n\n{}", table::speed_table(&set_names, &rows, REFERENCE, Clock::Cpu));
     println!("Mrays/s, wall clock (ratio to {REFERENCE}):\n\n{}", table::speed_table(&set_names, &rows, REFERENCE, Clock::Wall));
+    let robust = rows.iter().find(|r| r.structure == ROBUST);
+    if robust.is_some() {
+        println!("Mrays/s per CPU second (ratio to {ROBUST}: Embree with the guarantees of raylab's kernels):\n\n{}", table::speed_table(&set_names, &rows, ROBUST, Clock::Cpu));
+    }
 
     let reference = rows.iter().find(|r| r.structure == REFERENCE);
     let mut failures = Vec::new();
@@ -257,8 +266,8 @@ fn bench_scene(a: &BenchArgs, path: Option<&PathBuf>, accels: &[AccelKind], peer
                     failures.push(format!("{} on {} rays: {} disagree, more than the {} allowed; first {}", peer.name(), s.name, agreement.disagreeing, agreement.allowed(), agreement.first.as_deref().unwrap_or("")));
                 }
                 let speed = r.speeds[j].unwrap();
-                let ratio_to_embree = reference.and_then(|x| x.speeds[j]).map(|base| table::ratio(speed, base));
-                per_kind.insert(s.name.clone(), KindFigures { speed, ratio_to_embree, agreement });
+                let ratio_to = |r: Option<&Row>| r.and_then(|x| x.speeds[j]).map(|base| table::ratio(speed, base));
+                per_kind.insert(s.name.clone(), KindFigures { speed, ratio_to_embree: ratio_to(reference), ratio_to_embree_robust: ratio_to(robust), agreement });
             }
         }
         structures.push(StructureFigures { name: peer.name(), build_ms: *build_ms, memory_bytes: peer.memory_bytes(), bytes_per_triangle: peer.memory_bytes() as f64 / n as f64, rays: per_kind });
