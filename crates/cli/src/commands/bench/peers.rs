@@ -163,7 +163,7 @@ fn bench_scene(a: &BenchArgs, path: Option<&PathBuf>, accels: &[AccelKind], peer
     drop(oracle);
 
     // Builds: the median of `repeats` builds, keeping the last structure.
-    let mut built: Vec<(Box<dyn Peer + '_>, f64, bool)> = Vec::new();
+    let mut built: Vec<(Box<dyn Peer + '_>, f64)> = Vec::new();
     for &k in accels {
         let mut times = Vec::new();
         let mut last = None;
@@ -175,7 +175,7 @@ fn bench_scene(a: &BenchArgs, path: Option<&PathBuf>, accels: &[AccelKind], peer
         let accel = last.unwrap();
         accel.validate(prims).with_context(|| format!("{name}: {k} failed validation"))?;
         let peer = RaylabPeer { kind: k, accel, prims, mesh_bytes: if reads_mesh(k) { mesh_bytes } else { 0 } };
-        built.push((Box::new(peer), median(times), true));
+        built.push((Box::new(peer), median(times)));
     }
     for &k in peer_kinds {
         let mut times = Vec::new();
@@ -185,17 +185,14 @@ fn bench_scene(a: &BenchArgs, path: Option<&PathBuf>, accels: &[AccelKind], peer
             times.push(peer.build_ms());
             last = Some(peer);
         }
-        built.push((last.unwrap(), median(times), k.traced()));
+        built.push((last.unwrap(), median(times)));
     }
 
     // Traces: pass 0 is the warm-up; structures interleave within each pass.
     let mut timings: Vec<Vec<Vec<Timing>>> = vec![vec![Vec::new(); sets.len()]; built.len()];
     let mut agreements: Vec<Vec<Option<agree::Agreement>>> = vec![vec![None; sets.len()]; built.len()];
     for pass in 0..=a.repeats {
-        for (i, (peer, _, traced)) in built.iter().enumerate() {
-            if !traced {
-                continue;
-            }
+        for (i, (peer, _)) in built.iter().enumerate() {
             for (j, s) in sets.iter().enumerate() {
                 let (t, agreement) = if s.any_hit {
                     let mut out = vec![false; s.rays.len()];
@@ -221,15 +218,12 @@ fn bench_scene(a: &BenchArgs, path: Option<&PathBuf>, accels: &[AccelKind], peer
     let n = tris.len();
     println!("{name}: {n} triangles; {} threads; rays from a {}×{height} camera grid; oracle {oracle_kind}; median of {} passes", threads, a.resolution, a.repeats);
     println!("\n| structure | build ms | memory MiB | bytes/triangle |\n|---|---|---|---|");
-    for (peer, build_ms, _) in &built {
+    for (peer, build_ms) in &built {
         println!("| {} | {build_ms:.1} | {:.2} | {:.1} |", peer.name(), peer.memory_bytes() as f64 / (1 << 20) as f64, peer.memory_bytes() as f64 / n as f64);
     }
     let set_names: Vec<&str> = sets.iter().map(|s| s.name.as_str()).collect();
     let mut rows = Vec::new();
-    for (i, (peer, _, traced)) in built.iter().enumerate() {
-        if !traced {
-            continue;
-        }
+    for (i, (peer, _)) in built.iter().enumerate() {
         let speeds = sets
             .iter()
             .enumerate()
@@ -252,23 +246,19 @@ fn bench_scene(a: &BenchArgs, path: Option<&PathBuf>, accels: &[AccelKind], peer
     let reference = rows.iter().find(|r| r.structure == REFERENCE);
     let mut failures = Vec::new();
     let mut structures = Vec::new();
-    let mut row = rows.iter();
-    for (i, (peer, build_ms, traced)) in built.iter().enumerate() {
+    for (i, ((peer, build_ms), r)) in built.iter().zip(&rows).enumerate() {
         let mut per_kind = BTreeMap::new();
-        if *traced {
-            let r = row.next().unwrap();
-            for (j, s) in sets.iter().enumerate() {
-                let agreement = agreements[i][j].clone().unwrap();
-                if agreement.disagreeing > 0 {
-                    println!("{}: {} of {} {} rays disagree with the oracle (allowed {}): first {}", peer.name(), agreement.disagreeing, agreement.rays, s.name, agreement.allowed(), agreement.first.as_deref().unwrap_or(""));
-                }
-                if !agreement.ok() {
-                    failures.push(format!("{} on {} rays: {} disagree, more than the {} allowed; first {}", peer.name(), s.name, agreement.disagreeing, agreement.allowed(), agreement.first.as_deref().unwrap_or("")));
-                }
-                let speed = r.speeds[j].unwrap();
-                let ratio_to = |r: Option<&Row>| r.and_then(|x| x.speeds[j]).map(|base| table::ratio(speed, base));
-                per_kind.insert(s.name.clone(), KindFigures { speed, ratio_to_embree: ratio_to(reference), ratio_to_embree_robust: ratio_to(robust), agreement });
+        for (j, s) in sets.iter().enumerate() {
+            let agreement = agreements[i][j].clone().unwrap();
+            if agreement.disagreeing > 0 {
+                println!("{}: {} of {} {} rays disagree with the oracle (allowed {}): first {}", peer.name(), agreement.disagreeing, agreement.rays, s.name, agreement.allowed(), agreement.first.as_deref().unwrap_or(""));
             }
+            if !agreement.ok() {
+                failures.push(format!("{} on {} rays: {} disagree, more than the {} allowed; first {}", peer.name(), s.name, agreement.disagreeing, agreement.allowed(), agreement.first.as_deref().unwrap_or("")));
+            }
+            let speed = r.speeds[j].unwrap();
+            let ratio_to = |r: Option<&Row>| r.and_then(|x| x.speeds[j]).map(|base| table::ratio(speed, base));
+            per_kind.insert(s.name.clone(), KindFigures { speed, ratio_to_embree: ratio_to(reference), ratio_to_embree_robust: ratio_to(robust), agreement });
         }
         structures.push(StructureFigures { name: peer.name(), build_ms: *build_ms, memory_bytes: peer.memory_bytes(), bytes_per_triangle: peer.memory_bytes() as f64 / n as f64, rays: per_kind });
     }
