@@ -10,7 +10,7 @@ use raylab_core::Rgb;
 use raylab_render::light::LightSampling;
 use raylab_render::Scene;
 
-use crate::report::{base64, esc, loglog_chart, STYLE};
+use crate::report::{esc, loglog_chart, STYLE};
 
 /// The seed of a rendered reference is the renders' seed with these bits flipped: a reference
 /// sharing the renders' random streams would correlate with them and understate their error.
@@ -165,7 +165,7 @@ pub fn html(intro: &str, points: &[ConvergencePoint], images: &[LabelledImage]) 
     }
     h.push_str("</table><div class=\"thumbs\">");
     for i in images {
-        let _ = write!(h, "<figure><img alt=\"{l}\" src=\"data:image/png;base64,{}\"><figcaption>{l}</figcaption></figure>", base64(&i.png), l = esc(&i.label));
+        let _ = write!(h, "<figure><img alt=\"{l}\" src=\"data:image/png;base64,{}\"><figcaption>{l}</figcaption></figure>", base64::encode(&i.png), l = esc(&i.label));
     }
     h.push_str("</div></body></html>\n");
     h
