@@ -2,11 +2,10 @@
 
 use std::collections::BTreeMap;
 use std::fmt::Write;
+use std::path::PathBuf;
 
 use raylab_accel::AccelStats;
 use serde::{Deserialize, Serialize};
-
-use crate::sweep::{BenchSettings, JobsRecord};
 
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct RayFigures {
@@ -63,6 +62,53 @@ pub struct BenchReport {
     pub jobs: JobsRecord,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub heatmaps: Vec<HeatmapRecord>,
+}
+
+/// What a sweep measures; the job list follows from it alone, so that every shard of a run
+/// computes the same list.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct BenchSettings {
+    /// Scene files or bare meshes; `null` stands for the embedded default scene.
+    pub scenes: Vec<Option<PathBuf>>,
+    /// Structure names, in order.
+    pub accels: Vec<String>,
+    /// Whether the list was `all`: then `none` and `aabb` are skipped on scenes above
+    /// `oracle_limit` primitives.
+    pub all: bool,
+    /// Ray-set names, in order.
+    pub rays: Vec<String>,
+    pub resolution: u32,
+    pub repeats: u32,
+    pub oracle_limit: usize,
+    pub seed: u64,
+    /// Width of the heat maps (nodes visited per camera ray) to record; none when `null`.
+    pub heatmap_width: Option<u32>,
+}
+
+/// The `index`-th (from 1) of `count` shards of a job list.
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shard {
+    pub index: u32,
+    pub count: u32,
+}
+
+/// Which jobs of the list a report holds.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct JobsRecord {
+    /// Length of the full job list.
+    pub total: usize,
+    /// The shard this report ran; `null` for a whole run or a merge.
+    pub shard: Option<Shard>,
+    /// Jobs run, by position in the list.
+    pub ran: Vec<usize>,
+    /// Jobs left out by the rules of the method, with the reason.
+    pub skipped: Vec<SkippedJob>,
+}
+
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct SkippedJob {
+    pub job: usize,
+    pub reason: String,
 }
 
 /// What a scene's run found out before the timings: printed above its table.

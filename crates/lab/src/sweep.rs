@@ -10,32 +10,11 @@ use std::path::{Path, PathBuf};
 
 use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Primitives};
 use raylab_loader::Overrides;
-use serde::{Deserialize, Serialize};
 
+pub use crate::bench::{BenchSettings, JobsRecord, Shard, SkippedJob};
 use crate::bench::{cpu_name, median, BenchReport, BenchResult, HeatmapRecord, Machine, RayFigures, SceneSummary};
 use crate::heatmap;
 use crate::{rayfile, rays, RayKind, TraceResult};
-
-/// What a sweep measures; the job list follows from it alone, so that every shard of a run
-/// computes the same list.
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-pub struct BenchSettings {
-    /// Scene files or bare meshes; `null` stands for the embedded default scene.
-    pub scenes: Vec<Option<PathBuf>>,
-    /// Structure names, in order.
-    pub accels: Vec<String>,
-    /// Whether the list was `all`: then `none` and `aabb` are skipped on scenes above
-    /// `oracle_limit` primitives.
-    pub all: bool,
-    /// Ray-set names, in order.
-    pub rays: Vec<String>,
-    pub resolution: u32,
-    pub repeats: u32,
-    pub oracle_limit: usize,
-    pub seed: u64,
-    /// Width of the heat maps (nodes visited per camera ray) to record; none when `null`.
-    pub heatmap_width: Option<u32>,
-}
 
 impl BenchSettings {
     /// Settings with the defaults of `raylab bench`, for `scenes` and the structures in `accels`
@@ -113,13 +92,6 @@ pub fn jobs(settings: &BenchSettings) -> Result<Vec<Job>, LabError> {
     Ok(out)
 }
 
-/// The `index`-th (from 1) of `count` shards of a job list.
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Shard {
-    pub index: u32,
-    pub count: u32,
-}
-
 impl std::str::FromStr for Shard {
     type Err = String;
     fn from_str(s: &str) -> Result<Shard, String> {
@@ -145,25 +117,6 @@ impl Shard {
         let (i, c) = (self.index as usize, self.count as usize);
         (i - 1) * n / c..i * n / c
     }
-}
-
-/// Which jobs of the list a report holds.
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-pub struct JobsRecord {
-    /// Length of the full job list.
-    pub total: usize,
-    /// The shard this report ran; `null` for a whole run or a merge.
-    pub shard: Option<Shard>,
-    /// Jobs run, by position in the list.
-    pub ran: Vec<usize>,
-    /// Jobs left out by the rules of the method, with the reason.
-    pub skipped: Vec<SkippedJob>,
-}
-
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-pub struct SkippedJob {
-    pub job: usize,
-    pub reason: String,
 }
 
 #[derive(Debug, thiserror::Error)]
