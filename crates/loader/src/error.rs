@@ -50,13 +50,6 @@ pub fn shorten(text: &str) -> String {
     format!("{head}... ({} bytes)", text.len())
 }
 
-/// Reads a scene's text (at most [`crate::files::MAX_SCENE_BYTES`]), naming the file in
-/// every error, and the line of the first byte that is not UTF-8.
-pub fn read_text(path: &Path) -> Result<String, LoadError> {
-    let bytes = crate::files::read_capped(path, crate::files::MAX_SCENE_BYTES)?;
-    text_from_bytes(path, bytes)
-}
-
 pub fn text_from_bytes(path: &Path, bytes: Vec<u8>) -> Result<String, LoadError> {
     String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();

@@ -5,8 +5,14 @@
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
-use crate::error::LoadError;
+use crate::error::{text_from_bytes, LoadError};
 use raylab_render::memory_guard::human;
+
+/// Reads a scene's text (at most [`MAX_SCENE_BYTES`]), naming the file in every error, and
+/// the line of the first byte that is not UTF-8.
+pub fn read_text(path: &Path) -> Result<String, LoadError> {
+    text_from_bytes(path, read_capped(path, MAX_SCENE_BYTES)?)
+}
 
 /// Files compiled into the binary for the default scene.
 const EMBEDDED: &[(&str, &[u8])] = &[("bunny_4968.obj", include_bytes!("../../../assets/bunny_4968.obj"))];

@@ -48,7 +48,7 @@ pub fn parse_any(path: &Path, lenient: bool) -> Result<SceneDescription, LoadErr
         return mesh_scene::parse_mesh_scene(path);
     }
     if name.to_ascii_lowercase().ends_with(".toml") {
-        let src = error::read_text(path)?;
+        let src = files::read_text(path)?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         return parse_scene_str(&src, path, &files::Resolver::Disk { base });
     }

@@ -12,8 +12,7 @@ use raylab_render::TriangleMesh;
 use crate::error::{shorten, LoadError};
 use crate::files::{not_found_message, Found};
 
-/// An MTL material, kept as read; the scene loader turns it into a raylab material.
-pub type MtlMaterial = tobj::Material;
+pub use crate::obj_read::MtlMaterial;
 
 /// The meshes of one OBJ file, in world space, with the MTL materials they refer to.
 pub struct ObjData {

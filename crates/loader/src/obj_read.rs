@@ -13,7 +13,9 @@ use raylab_render::TriangleMesh;
 
 use crate::error::{shorten, text_from_bytes, LoadError};
 use crate::files::Lines;
-use crate::obj::MtlMaterial;
+
+/// An MTL material, kept as read; the scene loader turns it into a raylab material.
+pub type MtlMaterial = tobj::Material;
 
 /// An index slot of a face corner that is not given (`1//3`).
 const MISSING: u32 = u32::MAX;

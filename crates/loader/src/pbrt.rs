@@ -15,7 +15,8 @@ use raylab_render::texture::{Checker, CheckerSpace, Filter, ImageTexture, Wrap};
 use raylab_render::{Background, IntegratorKind, Light, Material, MaterialId, SamplerKind, Texture, TextureId, TriangleMesh};
 
 use crate::description::{CameraDescription, SceneDescription, Span};
-use crate::error::{read_text, LoadError};
+use crate::error::LoadError;
+use crate::files::read_text;
 use crate::files::{not_found_message, Resolver};
 
 /// The directives of the subset, for messages.

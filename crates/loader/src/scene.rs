@@ -44,7 +44,7 @@ const ROTATE: &[&str] = &["axis", "degrees"];
 
 /// Reads a scene file and everything it names, and builds its acceleration structure.
 pub fn load_scene(path: &Path, overrides: &Overrides) -> Result<Scene, LoadError> {
-    let src = crate::error::read_text(path)?;
+    let src = crate::files::read_text(path)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     load_scene_str(&src, path, &Resolver::Disk { base }, overrides)
 }
