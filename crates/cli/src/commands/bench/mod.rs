@@ -56,8 +56,9 @@ pub struct BenchArgs {
     /// Seed of the diffuse and shadow rays
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Other engines' structures to trace side by side with raylab's: embree, obvhs, bvh
-    /// (needs a build with `--features peers,embree`; see scripts/peers.sh)
+    /// Other engines' structures to trace side by side with raylab's: embree (HIGH, MEDIUM
+    /// and HIGH robust; one alone as embree-medium or embree-robust), obvhs, bvh (needs a
+    /// build with `--features peers,embree`; see scripts/peers.sh)
     #[arg(long)]
     pub peers: Option<String>,
     /// Run only the I-th of N shards of the job list (scene × structure × ray set, in that
