@@ -40,9 +40,10 @@ pub use packet::PACKET;
 pub enum Kernel {
     /// Plain Rust, on any CPU.
     Portable,
-    /// `std::arch`: AVX2 for 8-wide nodes, SSE2 for 4-wide (x86-64 only). Packets of
-    /// 8-wide nodes go ray-major in halves of eight rays (`wide/ray_major/avx2.rs`), those
-    /// whose rays do not share box rows and shear axes child-major (`wide/packet.rs`).
+    /// `std::arch`: AVX2 (with BMI1 and BMI2) for 8-wide nodes, SSE2 for 4-wide (x86-64
+    /// only). Packets of 8-wide nodes go ray-major in halves of eight rays
+    /// (`wide/ray_major/avx2.rs`), those whose rays do not share box rows and shear axes
+    /// child-major (`wide/packet.rs`).
     Simd,
     /// The same intrinsics with the whole traversal compiled for AVX-512F/VL: 32 vector
     /// registers instead of 16 and mask registers for the compares. Same IEEE operations
