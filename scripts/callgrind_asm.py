@@ -9,7 +9,7 @@ loops and its rare paths can be told apart (docs/performance.md, twenty-third ro
     scripts/callgrind_asm.py cg.out target/release/raylab closest_avx2 --per 88090 > asm.txt
 
 --per divides every count (the rays traced: `--repeats 1` traces each ray twice, a warm-up
-pass and a timed one). The last lines sum the instructions executed about once per unit
+pass and a timed one). The last line sums the instructions executed about once per unit
 (set-up and tear-down), more often (loops) and less often (rare paths).
 Needs objdump (binutils).
 """
