@@ -38,7 +38,7 @@ pub use primitives::{Hit, PrimHit, Primitives};
 pub use sphere_bvh::SphereBvh;
 pub use stats::AccelStats;
 pub use wide::quant::QuantNode;
-pub use wide::{Kernel, WideBvh, PACKET};
+pub use wide::{Kernel, Prefetch, WideBvh, PACKET};
 
 /// What every acceleration structure offers.
 pub trait Accel: Send + Sync {
@@ -430,6 +430,28 @@ impl AnyAccel {
             AnyAccel::Bvh4(a) => AnyAccel::Bvh4(a.with_kernel(k)),
             AnyAccel::Bvh8Q(a) => AnyAccel::Bvh8Q(a.with_kernel(k)),
             a => a,
+        }
+    }
+
+    /// Sets whether the single rays of a wide BVH prefetch the children they enter and
+    /// push (no effect on other structures).
+    pub fn with_prefetch(self, p: Prefetch) -> Self {
+        match self {
+            AnyAccel::Bvh8(a) => AnyAccel::Bvh8(a.with_prefetch(p)),
+            AnyAccel::Bvh4(a) => AnyAccel::Bvh4(a.with_prefetch(p)),
+            AnyAccel::Bvh8Q(a) => AnyAccel::Bvh8Q(a.with_prefetch(p)),
+            a => a,
+        }
+    }
+
+    /// Whether single rays prefetch the children they enter and push; `None` for
+    /// structures other than wide BVHs.
+    pub fn prefetches_children(&self) -> Option<bool> {
+        match self {
+            AnyAccel::Bvh8(a) => Some(a.prefetches_children()),
+            AnyAccel::Bvh4(a) => Some(a.prefetches_children()),
+            AnyAccel::Bvh8Q(a) => Some(a.prefetches_children()),
+            _ => None,
         }
     }
 }

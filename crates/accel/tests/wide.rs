@@ -2,7 +2,7 @@
 //! distance and barycentrics), the counting and fast paths agree, and the layouts hold
 //! the triangles they were built from.
 
-use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Kernel, Primitives, PACKET};
+use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Kernel, Prefetch, Primitives, PACKET};
 use raylab_core::{Aabb, Pcg32, Ray, Vec3};
 use raylab_testkit::{self as kit, Soup};
 
@@ -13,10 +13,14 @@ const WIDE: [AccelKind; 4] = [AccelKind::Bvh8, AccelKind::Bvh4, AccelKind::Bvh8S
 const SIMD_KERNELS: [Kernel; 2] = [Kernel::Simd, Kernel::Avx512];
 
 fn check_kernels_agree(name: &str, soup: &Soup, rays: &[Ray]) {
-    for (kind, kernel) in WIDE.into_iter().flat_map(|k| SIMD_KERNELS.map(|s| (k, s))) {
-        let name = &format!("{name}/{kernel:?}");
-        let simd = AnyAccel::build(kind, soup, &BuildOptions::default()).with_kernel(kernel);
-        let portable = AnyAccel::build(kind, soup, &BuildOptions::default()).with_kernel(Kernel::Portable);
+    // The SIMD walks with and without prefetching (which must not change an answer or
+    // the work counted) against the portable walk, which never prefetches.
+    let simd_walks = SIMD_KERNELS.into_iter().flat_map(|k| [(k, Prefetch::Off), (k, Prefetch::On)]);
+    for (kind, (kernel, prefetch)) in WIDE.into_iter().flat_map(|k| simd_walks.clone().map(move |s| (k, s))) {
+        let name = &format!("{name}/{kernel:?}/{prefetch:?}");
+        let simd = AnyAccel::build(kind, soup, &BuildOptions::default()).with_kernel(kernel).with_prefetch(prefetch);
+        assert_eq!(simd.prefetches_children(), Some(prefetch == Prefetch::On), "{name}/{kind}");
+        let portable = AnyAccel::build(kind, soup, &BuildOptions::default()).with_kernel(Kernel::Portable).with_prefetch(Prefetch::Off);
         portable.validate(soup).unwrap_or_else(|e| panic!("{name}/{kind}: {e}"));
         let (mut cs, mut cp) = (Counters::default(), Counters::default());
         for (k, ray) in rays.iter().enumerate() {
@@ -316,4 +320,22 @@ fn subtrees_of_four_stay_one_leaf() {
     }
     assert_eq!(wide.blocks.len(), 2);
     assert!(wide.blocks.iter().all(|blk| blk.prim.iter().all(|&p| p != u32::MAX)), "both blocks full");
+}
+
+/// Prefetching is on by default only for structures of `PREFETCH_BYTES` and more:
+/// a cube's is off, and so is it when forced off after being forced on; other structures
+/// have none to set.
+#[test]
+fn prefetching_follows_the_structure_size_unless_forced() {
+    let soup = kit::cube();
+    for kind in [AccelKind::Bvh8, AccelKind::Bvh4, AccelKind::Bvh8Q] {
+        let a = AnyAccel::build(kind, &soup, &BuildOptions::default());
+        assert!(a.stats().memory_bytes < raylab_accel::wide::PREFETCH_BYTES);
+        assert_eq!(a.prefetches_children(), Some(false), "{kind}: auto");
+        let a = a.with_prefetch(Prefetch::On);
+        assert_eq!(a.prefetches_children(), Some(true), "{kind}: on");
+        assert_eq!(a.stats().notes.iter().find(|(k, _)| k == "prefetch").map(|(_, v)| v.as_str()), Some("entered and pushed children"));
+        assert_eq!(a.with_prefetch(Prefetch::Auto).prefetches_children(), Some(false), "{kind}: auto again");
+    }
+    assert_eq!(AnyAccel::build(AccelKind::Bvh, &soup, &BuildOptions::default()).with_prefetch(Prefetch::On).prefetches_children(), None);
 }

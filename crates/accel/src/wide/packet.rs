@@ -17,8 +17,8 @@ use raylab_core::Ray;
 #[cfg(target_arch = "x86_64")]
 use super::kernels::{child_boxes, slabs_avx2, slabs_of_rows_avx2};
 use super::ray::{BlockRay, RayBoxes, ROBUST_FAR};
-use super::node::{is_leaf, ChildRef, Layout, TriBlock, WideNode, EMPTY};
-use super::traverse::{block_closest, insert_sorted, leaf_slice, occupied, STACK};
+use super::node::{is_leaf, ChildRef, Layout, WideNode, EMPTY};
+use super::traverse::{block_closest, insert_sorted, leaf_slice, occupied, prefetch, STACK};
 use super::WideBvh;
 use crate::{Counters, Hit, Primitives};
 
@@ -153,22 +153,6 @@ fn reaching<const SIMD: bool>(t: f32, far: &Far, rays: RayMask) -> RayMask {
 /// Each ray's far limit for box tests, aligned for SIMD loads.
 #[repr(C, align(16))]
 struct Far([f32; PACKET]);
-
-/// Starts loading a pushed child: the packet works on its nearer siblings first.
-#[inline(always)]
-pub(super) fn prefetch<const W: usize, N: Layout<W>>(bvh: &WideBvh<W, N>, r: ChildRef) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        let (p, bytes) = if is_leaf(r) { ((&bvh.blocks[super::node::leaf_blocks(r).0] as *const TriBlock).cast::<i8>(), std::mem::size_of::<TriBlock>()) } else { ((&bvh.nodes[r as usize] as *const N).cast::<i8>(), std::mem::size_of::<N>()) };
-        // One prefetch per 64 bytes from the element's start (a last line it may reach
-        // into is left out: prefetching it measured no faster).
-        for line in (0..bytes).step_by(64) {
-            // SAFETY: a prefetch never faults; the addresses are within the element.
-            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(line)) };
-        }
-    }
-}
 
 /// Closest hits of `rays` (at most [`PACKET`]) into `out` (as long as `rays`). The counting
 /// build (`COUNT`) charges each ray the nodes it is active in and the occupied triangle

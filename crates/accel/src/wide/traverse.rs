@@ -1,6 +1,7 @@
 //! Closest-hit and any-hit traversal of a wide BVH, generic over the width, the kernel
-//! (SIMD or portable) and whether work is counted (a const flag, so the fast path carries
-//! no counter code).
+//! (SIMD or portable), whether work is counted and whether children are prefetched
+//! ([`Prefetch`](super::Prefetch)): const flags, so the fast path carries no counter code
+//! and a walk that does not prefetch no test of whether it should.
 //!
 //! The stack holds `(node, entry distance)` pairs and is never cleared: a pop whose entry
 //! lies beyond the current closest hit is dropped without touching the node's memory.
@@ -174,22 +175,40 @@ pub(super) fn leaf_slice<const W: usize, N: Layout<W>>(bvh: &WideBvh<W, N>, r: C
     &bvh.blocks[first..first + n]
 }
 
+/// Starts loading a child's node or first block, all its cache lines: a pushed child is
+/// popped after its nearer siblings' subtrees, and an entered node's child references sit
+/// in its last line, read only once its box test is done.
+#[inline(always)]
+pub(super) fn prefetch<const W: usize, N: Layout<W>>(bvh: &WideBvh<W, N>, r: ChildRef) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        let (p, bytes) = if is_leaf(r) { ((&bvh.blocks[super::node::leaf_blocks(r).0] as *const TriBlock).cast::<i8>(), std::mem::size_of::<TriBlock>()) } else { ((&bvh.nodes[r as usize] as *const N).cast::<i8>(), std::mem::size_of::<N>()) };
+        // One prefetch per 64 bytes from the element's start (a last line it may reach
+        // into is left out: prefetching it measured no faster).
+        for line in (0..bytes).step_by(64) {
+            // SAFETY: a prefetch never faults; the addresses are within the element.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(line)) };
+        }
+    }
+}
+
 /// The portable walk of the rare rays the SIMD walk hands over, out of line so that it
 /// does not share the SIMD walk's function and registers.
 #[inline(never)]
 fn closest_portable<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
-    closest::<P, W, N, false, COUNT>(bvh, prims, ray, c)
+    closest::<P, W, N, false, COUNT, false>(bvh, prims, ray, c)
 }
 
 #[inline(never)]
 fn any_portable<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
-    any::<P, W, N, false, COUNT>(bvh, prims, ray, c)
+    any::<P, W, N, false, COUNT, false>(bvh, prims, ray, c)
 }
 
 /// The children of interior node `cur` that the ray enters within `t_max`: pushes all but
 /// the nearest, far to near, and returns the nearest; `None` when it enters none.
 #[inline(always)]
-fn enter_closest<const W: usize, N: Layout<W>, const SIMD: bool>(bvh: &WideBvh<W, N>, cur: ChildRef, rb: &RayBoxes, t_max: f32, stack: &mut [MaybeUninit<Entry>; STACK], sp: &mut usize) -> Option<ChildRef> {
+fn enter_closest<const W: usize, N: Layout<W>, const SIMD: bool, const PF: bool>(bvh: &WideBvh<W, N>, cur: ChildRef, rb: &RayBoxes, t_max: f32, stack: &mut [MaybeUninit<Entry>; STACK], sp: &mut usize) -> Option<ChildRef> {
     let node = &bvh.nodes[cur as usize];
     let mut tnear = [0.0f32; W];
     let mask = node.boxes::<SIMD>(rb, t_max * ROBUST_FAR, &mut tnear);
@@ -198,7 +217,7 @@ fn enter_closest<const W: usize, N: Layout<W>, const SIMD: bool>(bvh: &WideBvh<W
     }
     let first = mask.trailing_zeros() as usize;
     if mask & (mask - 1) == 0 {
-        return Some(node.child(first));
+        return Some(entered::<W, N, PF>(bvh, node.child(first)));
     }
     let rest = mask & (mask - 1);
     if rest & (rest - 1) == 0 {
@@ -207,9 +226,8 @@ fn enter_closest<const W: usize, N: Layout<W>, const SIMD: bool>(bvh: &WideBvh<W
         let second = rest.trailing_zeros() as usize;
         let key = |l: usize| (tnear[l].to_bits() & !(W as u32 - 1)) | l as u32;
         let (near, far) = if key(second) < key(first) { (second, first) } else { (first, second) };
-        stack[*sp] = MaybeUninit::new(Entry { node: node.child(far), t: tnear[far] });
-        *sp += 1;
-        return Some(node.child(near));
+        push::<W, N, PF>(bvh, stack, sp, Entry { node: node.child(far), t: tnear[far] });
+        return Some(entered::<W, N, PF>(bvh, node.child(near)));
     }
     // Sort the hit lanes by entry distance: keys are the distance's bits (in order for
     // t >= 0) with the lane in the low bits.
@@ -224,10 +242,28 @@ fn enter_closest<const W: usize, N: Layout<W>, const SIMD: bool>(bvh: &WideBvh<W
     }
     for &key in keys[1..n].iter().rev() {
         let l = (key & lane_bits) as usize;
-        stack[*sp] = MaybeUninit::new(Entry { node: node.child(l), t: tnear[l] });
-        *sp += 1;
+        push::<W, N, PF>(bvh, stack, sp, Entry { node: node.child(l), t: tnear[l] });
     }
-    Some(node.child((keys[0] & lane_bits) as usize))
+    Some(entered::<W, N, PF>(bvh, node.child((keys[0] & lane_bits) as usize)))
+}
+
+/// The child entered next, prefetched with `PF`.
+#[inline(always)]
+fn entered<const W: usize, N: Layout<W>, const PF: bool>(bvh: &WideBvh<W, N>, r: ChildRef) -> ChildRef {
+    if PF {
+        prefetch(bvh, r);
+    }
+    r
+}
+
+/// Pushes `e`, prefetching its node or block with `PF` ([`Prefetch`](super::Prefetch)).
+#[inline(always)]
+fn push<const W: usize, N: Layout<W>, const PF: bool>(bvh: &WideBvh<W, N>, stack: &mut [MaybeUninit<Entry>; STACK], sp: &mut usize, e: Entry) {
+    if PF {
+        prefetch(bvh, e.node);
+    }
+    stack[*sp] = MaybeUninit::new(e);
+    *sp += 1;
 }
 
 /// The next pushed node whose entry lies within `t_max` (the others are dropped without
@@ -247,7 +283,7 @@ fn pop_closest(stack: &[MaybeUninit<Entry>; STACK], sp: &mut usize, t_max: f32) 
 }
 
 #[inline(always)]
-pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SIMD: bool, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
+pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SIMD: bool, const COUNT: bool, const PF: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> Option<Hit> {
     // The per-ray constants are read from the caller's ray, not from the copy below: a
     // load of a few lanes out of a just-stored 32-byte copy misses store forwarding.
     let rb = RayBoxes::new(ray);
@@ -273,7 +309,7 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
         if COUNT {
             w.nodes += 1;
         }
-        match enter_closest::<W, N, SIMD>(bvh, cur, &rb, ray.t_max, &mut stack, &mut sp).or_else(|| pop_closest(&stack, &mut sp, ray.t_max)) {
+        match enter_closest::<W, N, SIMD, PF>(bvh, cur, &rb, ray.t_max, &mut stack, &mut sp).or_else(|| pop_closest(&stack, &mut sp, ray.t_max)) {
             Some(next) => cur = next,
             None => {
                 if COUNT {
@@ -293,7 +329,7 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
         }
         if is_leaf(cur) {
             leaf_closest::<P, SIMD, COUNT>(leaf_slice(bvh, cur), prims, &s, &br, &mut ray, &mut best, &mut w);
-        } else if let Some(next) = enter_closest::<W, N, SIMD>(bvh, cur, &rb, ray.t_max, &mut stack, &mut sp) {
+        } else if let Some(next) = enter_closest::<W, N, SIMD, PF>(bvh, cur, &rb, ray.t_max, &mut stack, &mut sp) {
             cur = next;
             continue;
         }
@@ -310,7 +346,7 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
 }
 
 #[inline(always)]
-pub(super) fn any<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SIMD: bool, const COUNT: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
+pub(super) fn any<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SIMD: bool, const COUNT: bool, const PF: bool>(bvh: &WideBvh<W, N>, prims: &P, ray: &Ray, c: &mut Counters) -> bool {
     let rb = RayBoxes::new(ray);
     if SIMD && !rb.by_bits {
         // As in `closest`.
@@ -344,10 +380,14 @@ pub(super) fn any<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SI
             let mut mask = node.boxes::<SIMD>(&rb, ray.t_max * ROBUST_FAR, &mut tnear);
             if mask != 0 {
                 // Any hit will do: no ordering, the first lane is entered, the rest pushed.
-                cur = node.child(mask.trailing_zeros() as usize);
+                cur = entered::<W, N, PF>(bvh, node.child(mask.trailing_zeros() as usize));
                 mask &= mask - 1;
                 while mask != 0 {
-                    stack[sp] = MaybeUninit::new(node.child(mask.trailing_zeros() as usize));
+                    let child = node.child(mask.trailing_zeros() as usize);
+                    if PF {
+                        prefetch(bvh, child);
+                    }
+                    stack[sp] = MaybeUninit::new(child);
                     sp += 1;
                     mask &= mask - 1;
                 }

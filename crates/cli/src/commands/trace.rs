@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, BuildQuality, Kernel};
+use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, BuildQuality, Kernel, Prefetch};
 use raylab_loader::Overrides;
 
 #[derive(Args, Clone, Debug)]
@@ -42,6 +42,10 @@ pub struct TraceArgs {
     /// answers)
     #[arg(long, default_value = "auto", value_enum)]
     pub kernel: KernelArg,
+    /// Whether single rays through the wide BVHs prefetch each child they enter or push:
+    /// auto (on for structures of 32 MiB and more), on or off (the same answers)
+    #[arg(long, default_value = "auto", value_enum)]
+    pub prefetch: PrefetchArg,
     /// Print JSON
     #[arg(long)]
     pub json: bool,
@@ -55,6 +59,13 @@ pub enum KernelArg {
     Simd,
     /// The SIMD kernels compiled for AVX-512F/VL (32 vector registers); 8-wide packets ray-major, 16 rays per register
     Avx512,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PrefetchArg {
+    Auto,
+    On,
+    Off,
 }
 
 pub fn run(a: &TraceArgs) -> Result<()> {
@@ -77,6 +88,12 @@ pub fn run(a: &TraceArgs) -> Result<()> {
             KernelArg::Simd => accel.with_kernel(Kernel::Simd),
             KernelArg::Avx512 => accel.with_kernel(Kernel::Avx512),
         };
+        accel = accel.with_prefetch(match a.prefetch {
+            PrefetchArg::Auto => Prefetch::Auto,
+            PrefetchArg::On => Prefetch::On,
+            PrefetchArg::Off => Prefetch::Off,
+        });
+        let prefetch = accel.prefetches_children().unwrap_or(false) && a.packet.is_none();
         let kernel = if a.packet.is_some() { accel.packet_kernel() } else { accel.kernel() };
         let kernel = kernel.map_or("-".to_string(), |k| format!("{k:?}").to_lowercase());
         let build_ms = accel.stats().build_ms;
@@ -96,7 +113,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
         if a.json {
             println!(
                 "{}",
-                serde_json::json!({ "rays": r.count, "hits": r.hits, "t_sum": r.t_sum, "seconds": seconds, "mrays_per_s": mrays, "accel": kind.name(), "build_quality": a.build_quality.name(), "build_ms": build_ms, "any_hit": a.any_hit, "packet": a.packet.unwrap_or(1), "kernel": kernel, "threads": rayon::current_num_threads() })
+                serde_json::json!({ "rays": r.count, "hits": r.hits, "t_sum": r.t_sum, "seconds": seconds, "mrays_per_s": mrays, "accel": kind.name(), "build_quality": a.build_quality.name(), "build_ms": build_ms, "any_hit": a.any_hit, "packet": a.packet.unwrap_or(1), "kernel": kernel, "prefetch": prefetch, "threads": rayon::current_num_threads() })
             );
         } else {
             let query = match a.packet {
@@ -104,7 +121,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
                 None if a.any_hit => "any hit".into(),
                 None => "closest hit".into(),
             };
-            println!("rays {}  hits {}  t_sum {:.6}  {:.2} Mrays/s ({}, {}, {kernel} kernel, median of {} on {} threads; built in {build_ms:.1} ms at {} quality)", r.count, r.hits, r.t_sum, mrays, kind, query, a.repeats, rayon::current_num_threads(), a.build_quality);
+            println!("rays {}  hits {}  t_sum {:.6}  {:.2} Mrays/s ({}, {}, {kernel} kernel{}, median of {} on {} threads; built in {build_ms:.1} ms at {} quality)", r.count, r.hits, r.t_sum, mrays, kind, query, if prefetch { ", prefetching" } else { "" }, a.repeats, rayon::current_num_threads(), a.build_quality);
         }
         Ok(())
     })

@@ -59,7 +59,7 @@ use raylab_core::{gamma, Ray};
 
 use super::ray::{BlockRay, ROBUST_FAR};
 use super::node::{is_leaf, Layout, TriBlock, WideNode, EMPTY};
-use super::packet::prefetch;
+use super::traverse::prefetch;
 use super::traverse::{block_closest, exact_lane, insert_sorted, leaf_slice, occupied, wins, STACK};
 use super::WideBvh;
 use crate::{Counters, Hit, Primitives};

@@ -136,7 +136,7 @@ fn check<V: Vector, N: Layout<8>>(v: V, bvh: &WideBvh<8, N>, prims: &Mixed, pack
         }
         taken += 1;
         for (r, ray) in rays.iter().enumerate() {
-            let want = crate::wide::traverse::closest::<_, 8, N, true, false>(bvh, prims, ray, &mut Counters::default());
+            let want = crate::wide::traverse::closest::<_, 8, N, true, false, false>(bvh, prims, ray, &mut Counters::default());
             assert_eq!(out[r], want, "{} rays, packet {k} ray {r}", V::RAYS);
             assert_eq!(counted[r], want, "{} rays, packet {k} ray {r}: counting build", V::RAYS);
             hits += usize::from(want.is_some());
@@ -146,7 +146,7 @@ fn check<V: Vector, N: Layout<8>>(v: V, bvh: &WideBvh<8, N>, prims: &Mixed, pack
         let copies = vec![rays[0]; V::RAYS];
         let (mut cn, mut c1) = (Counters::default(), Counters::default());
         assert!(super::closest::<V, _, 8, N, true>(v, bvh, prims, &copies, &mut vec![None; V::RAYS], &mut cn));
-        crate::wide::traverse::closest::<_, 8, N, true, true>(bvh, prims, &rays[0], &mut c1);
+        crate::wide::traverse::closest::<_, 8, N, true, true, false>(bvh, prims, &rays[0], &mut c1);
         let n = V::RAYS as u64;
         assert_eq!((cn.nodes_visited, cn.prim_tests), (n * c1.nodes_visited, n * c1.prim_tests), "{} rays, packet {k}: copies", V::RAYS);
     }
