@@ -9,7 +9,7 @@
 //! come out exact: a plane at `c` is hit at `t = |c − o|` from a ray starting at `o`.
 
 use raylab_accel::bvh::{Bvh, BvhNode};
-use raylab_accel::wide::node::{leaf_ref, Layout, TriBlock, WideNode};
+use raylab_accel::wide::node::{is_leaf, leaf_ref, node_index, node_ref, Layout, TriBlock, WideNode, EMPTY};
 use raylab_accel::{Accel, AccelKind, AnyAccel, BuildOptions, Counters, Hit, Kernel, Primitives, QuantNode, WideBvh, PACKET};
 use raylab_core::{Aabb, Ray, Vec3};
 use raylab_testkit::{Prim, Soup};
@@ -291,7 +291,9 @@ fn quant_by_hand(soup: &Soup, nodes: &[WideNode<8>], blocks: Vec<TriBlock>, root
     let bin = Bvh::from_parts(vec![BvhNode::leaf(soup.bounds(), 0, n)], (0..n).collect(), n as usize, "one leaf");
     let mut w = WideBvh::<8, QuantNode>::from_binary(&bin, soup, "by hand").with_kernel(kernel);
     assert_eq!(w.kernel(), kernel);
-    w.nodes = nodes.iter().map(<QuantNode as Layout<8>>::encode).collect();
+    // Interior references count in units of 32 bytes: node k of 224 bytes is node k of 96.
+    let requant = |r: u32| if r == EMPTY || is_leaf(r) { r } else { node_ref::<QuantNode>(node_index::<WideNode<8>>(r).expect("at a node's start")) };
+    w.nodes = nodes.iter().map(|n| WideNode { child: n.child.map(requant), ..*n }).map(|n| <QuantNode as Layout<8>>::encode(&n)).collect();
     w.blocks = blocks;
     w.root = root;
     w
@@ -547,7 +549,7 @@ fn wide_ties_across_levels() {
         for kernel in kernels(8) {
             let mut root = WideNode::<8>::EMPTY_NODE;
             root.set(0, &pb(&soup, 1), leaf_ref(0, 1));
-            root.set(1, &pb(&soup, 0), 1);
+            root.set(1, &pb(&soup, 0), node_ref::<WideNode<8>>(1));
             let mut inner = WideNode::<8>::EMPTY_NODE;
             inner.set(0, &pb(&soup, 0), leaf_ref(1, 1));
             let w = wide_by_hand(&soup, vec![root, inner], vec![block(&soup, &[1]), block(&soup, &[0])], 0, kernel);
@@ -604,7 +606,7 @@ fn wide_boxes_after_a_hit_are_tested_against_it() {
         for kernel in kernels(8) {
             let mut root = WideNode::<8>::EMPTY_NODE;
             root.set(0, &pb(&soup, 0), leaf_ref(0, 1));
-            root.set(1, &pb(&soup, 1).union(pb(&soup, 0)), 1);
+            root.set(1, &pb(&soup, 1).union(pb(&soup, 0)), node_ref::<WideNode<8>>(1));
             let mut inner = WideNode::<8>::EMPTY_NODE;
             inner.set(0, &pb(&soup, 1), leaf_ref(1, 1));
             let w = wide_by_hand(&soup, vec![root, inner], vec![block(&soup, &[0]), block(&soup, &[1])], 0, kernel);
@@ -921,7 +923,7 @@ fn wide_bvh_calls_intersect_only_for_non_triangles() {
 fn two_levels(soup: &Soup) -> WideBvh<8> {
     let mut root = WideNode::<8>::EMPTY_NODE;
     root.set(0, &pb(soup, 0), leaf_ref(0, 1));
-    root.set(1, &pb(soup, 1), 1);
+    root.set(1, &pb(soup, 1), node_ref::<WideNode<8>>(1));
     let mut inner = WideNode::<8>::EMPTY_NODE;
     inner.set(0, &pb(soup, 1), leaf_ref(1, 1));
     wide_by_hand(soup, vec![root, inner], vec![block(soup, &[0]), block(soup, &[1])], 0, Kernel::Portable)
@@ -980,8 +982,9 @@ fn wide_validation_finds_each_broken_invariant() {
     // block only by its triangles' edge functions).
     assert_eq!(broken(&|t| t.blocks[0].prim[0] |= 1 << 31), "block 0 lane 0: primitive 0 is not a triangle, yet has vertices");
     assert_eq!(broken(&|t| t.nodes[0].bounds[4][0] = 0.0), "primitive 0 sticks out of its leaf box");
-    assert_eq!(broken(&|t| t.nodes[1].child[0] = 1), "node 1 out of range or reached twice");
-    assert_eq!(broken(&|t| t.nodes[0].child[1] = 5), "node 5 out of range or reached twice");
+    assert_eq!(broken(&|t| t.nodes[1].child[0] = node_ref::<WideNode<8>>(1)), "node 1 out of range or reached twice");
+    assert_eq!(broken(&|t| t.nodes[0].child[1] = node_ref::<WideNode<8>>(5)), "node 5 out of range or reached twice");
+    assert_eq!(broken(&|t| t.nodes[0].child[1] = 1), "reference 1 falls inside a node");
     assert_eq!(broken(&|t| (t.nodes[1].bounds[0][3], t.nodes[1].bounds[3][3]) = (0.0, 1.0)), "node 1 lane 3: an empty slot with a non-empty box");
     assert_eq!(broken(&|t| t.nodes[1].bounds[5][0] = 20.0), "node 1 lane 0 sticks out of its parent");
     assert_eq!(broken(&|t| t.nodes.push(WideNode::EMPTY_NODE)), "node 2 is unreachable");

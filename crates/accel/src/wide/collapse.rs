@@ -13,7 +13,7 @@
 use rayon::prelude::*;
 use raylab_core::Aabb;
 
-use super::node::{leaf_ref, ChildRef, TriBlock, WideNode, EMPTY, MAX_BLOCKS, MAX_LEAF_BLOCKS};
+use super::node::{leaf_ref, node_ref, ChildRef, TriBlock, WideNode, EMPTY, MAX_BLOCKS, MAX_LEAF_BLOCKS, NODE_UNIT};
 use crate::bvh::{Bvh, BvhNode};
 use crate::par::DisjointSlice;
 use crate::Primitives;
@@ -43,6 +43,9 @@ struct Ctx<'a, P: ?Sized, const W: usize> {
     /// The dynamic programme's choices per binary node (see [`plan`]).
     plan: Vec<Plan<W>>,
     fork_refs: usize,
+    /// A node's size in the final layout, in [`NODE_UNIT`]s: interior references are
+    /// offsets ([`node_ref`]).
+    stride: usize,
 }
 
 /// What a subtree emits: wide nodes and triangle blocks. The plan knows it before anything
@@ -101,13 +104,15 @@ impl<'o, const W: usize> Part<'o, W> {
     }
 }
 
-pub(super) fn collapse<P: Primitives + ?Sized, const W: usize>(bvh: &Bvh, prims: &P) -> Collapsed<W> {
-    collapse_forking(bvh, prims, FORK_REFS)
+/// The wide tree of `bvh`, its interior references pointing into a layout of nodes `N`
+/// (which encodes the returned f32 nodes one for one).
+pub(super) fn collapse<P: Primitives + ?Sized, const W: usize, N>(bvh: &Bvh, prims: &P) -> Collapsed<W> {
+    collapse_forking::<P, W, N>(bvh, prims, FORK_REFS)
 }
 
 /// [`collapse`], emitting the children of wide nodes over `fork_refs` references or more
 /// as parallel tasks (tests compare forking everywhere with never).
-fn collapse_forking<P: Primitives + ?Sized, const W: usize>(bvh: &Bvh, prims: &P, fork_refs: usize) -> Collapsed<W> {
+fn collapse_forking<P: Primitives + ?Sized, const W: usize, N>(bvh: &Bvh, prims: &P, fork_refs: usize) -> Collapsed<W> {
     assert!(prims.len() < TriBlock::OTHER as usize, "wide BVH: more than 2^31 primitives");
     let bin = &bvh.nodes[..];
     if bin.is_empty() {
@@ -119,7 +124,9 @@ fn collapse_forking<P: Primitives + ?Sized, const W: usize>(bvh: &Bvh, prims: &P
     let plan = plan::<W>(bin, distinct);
     let size = plan[0].size;
     assert!(size.blocks as usize <= MAX_BLOCKS, "wide BVH: too many triangle blocks");
-    let ctx = Ctx { bin, indices: &bvh.indices, prims, plan, fork_refs };
+    // Every node's reference stays below the leaf flag.
+    node_ref::<N>(size.nodes as usize);
+    let ctx = Ctx { bin, indices: &bvh.indices, prims, plan, fork_refs, stride: std::mem::size_of::<N>() / NODE_UNIT };
     // Filled in parallel: tens of MiB written (and their pages faulted in) by one thread
     // were a third of the collapse's time at 16 threads.
     let mut nodes: Vec<WideNode<W>> = (0..size.nodes as usize).into_par_iter().map(|_| WideNode::EMPTY_NODE).collect();
@@ -279,7 +286,7 @@ impl<P: Primitives + ?Sized, const W: usize> Ctx<'_, P, W> {
             }
             assert!(out.nodes.is_empty() && out.blocks.is_empty(), "the plan sized the subtree");
         }
-        node.node_base as ChildRef
+        (node.node_base * self.stride) as ChildRef
     }
 
     /// The binary nodes that subtree `i` puts in at most `j` slots of its parent, appended
@@ -324,7 +331,7 @@ impl<P: Primitives + ?Sized, const W: usize> Ctx<'_, P, W> {
             let r = self.leaf(chunk, cb, out.take(leaf_size::<W>(chunk.len())));
             node.nodes[0].set(lane, &cb, r);
         }
-        node.node_base as ChildRef
+        (node.node_base * self.stride) as ChildRef
     }
 }
 
@@ -352,10 +359,10 @@ mod tests {
             .collect();
         let prims = crate::primitives::TestBoxes(boxes);
         let bvh = Bvh::build(&prims, crate::bvh::SplitMethod::BinnedSah, &crate::BuildOptions::default());
-        let serial = collapse_forking::<_, 8>(&bvh, &prims, usize::MAX);
+        let serial = collapse_forking::<_, 8, WideNode<8>>(&bvh, &prims, usize::MAX);
         assert!(serial.nodes.len() > 50, "a tree deep enough to fork at several levels");
         for fork_refs in [1, 64, 1000] {
-            let forked = collapse_forking::<_, 8>(&bvh, &prims, fork_refs);
+            let forked = collapse_forking::<_, 8, WideNode<8>>(&bvh, &prims, fork_refs);
             assert_eq!(forked.root, serial.root);
             assert!(forked.nodes == serial.nodes, "nodes differ when forking at {fork_refs} references");
             assert!(forked.blocks == serial.blocks, "blocks differ when forking at {fork_refs} references");
@@ -382,14 +389,14 @@ mod tests {
         let same = crate::primitives::TestBoxes(vec![Aabb::new(Vec3::ZERO, Vec3::ONE); 300]);
         let bin = vec![BvhNode::leaf(aabb(1.0, 1.0, 1.0), 0, 300)];
         let bvh = Bvh::from_parts(bin, (0..300).collect(), 300, "one big leaf");
-        let c = collapse_forking::<_, 8>(&bvh, &same, 1);
+        let c = collapse_forking::<_, 8, WideNode<8>>(&bvh, &same, 1);
         // Chunks of 38: seven of ten blocks and one of 34 references, nine blocks.
         assert_eq!(leaf_size::<8>(300), Size { nodes: 1, blocks: 7 * 10 + 9 });
         assert_eq!((c.nodes.len(), c.blocks.len()), (1, 79));
         // Leaves {0..4} and {2..6}, both whole in one leaf of six distinct primitives.
         let bin = vec![BvhNode::interior(aabb(1.0, 1.0, 1.0), 1), BvhNode::leaf(aabb(1.0, 1.0, 1.0), 0, 4), BvhNode::leaf(aabb(1.0, 1.0, 1.0), 4, 4)];
         let bvh = Bvh::from_parts(bin, vec![0, 1, 2, 3, 2, 3, 4, 5], 6, "repeats").with_spatial_splits();
-        let c = collapse_forking::<_, 8>(&bvh, &crate::primitives::TestBoxes(vec![Aabb::new(Vec3::ZERO, Vec3::ONE); 6]), 1);
+        let c = collapse_forking::<_, 8, WideNode<8>>(&bvh, &crate::primitives::TestBoxes(vec![Aabb::new(Vec3::ZERO, Vec3::ONE); 6]), 1);
         assert_eq!((c.root, c.nodes.len(), c.blocks.len()), (leaf_ref(0, 2), 0, 2));
         assert_eq!(c.blocks[1].prim.map(|p| p & !TriBlock::OTHER), [4, 5, EMPTY & !TriBlock::OTHER, EMPTY & !TriBlock::OTHER]);
     }
@@ -446,7 +453,7 @@ mod tests {
         let bin = vec![BvhNode::interior(aabb(1.0, 1.0, 1.0), 1), BvhNode::leaf(aabb(1.0, 1.0, 1.0), 0, 3), BvhNode::leaf(aabb(1.0, 1.0, 1.0), 3, 3)];
         let bvh = Bvh::from_parts(bin, (0..6).collect(), 6, "six");
         for fork_refs in [1, usize::MAX] {
-            let c = collapse_forking::<_, 8>(&bvh, &boxes(6), fork_refs);
+            let c = collapse_forking::<_, 8, WideNode<8>>(&bvh, &boxes(6), fork_refs);
             assert_eq!((c.root, c.nodes.len()), (leaf_ref(0, 2), 0), "one leaf, forking at {fork_refs}");
             assert_eq!(c.blocks.iter().map(|b| b.prim).collect::<Vec<_>>(), [other([0, 1, 2, 3]), other([4, 5, EMPTY, EMPTY])]);
         }
@@ -460,7 +467,7 @@ mod tests {
         ];
         let bvh = Bvh::from_parts(bin, (0..20).collect(), 20, "r-a-b");
         for fork_refs in [1, usize::MAX] {
-            let c = collapse_forking::<_, 4>(&bvh, &boxes(20), fork_refs);
+            let c = collapse_forking::<_, 4, WideNode<4>>(&bvh, &boxes(20), fork_refs);
             assert_eq!((c.root, c.nodes.len(), c.blocks.len()), (0, 1, 5), "forking at {fork_refs}");
             let n = &c.nodes[0];
             assert_eq!(n.child, [leaf_ref(0, 2), leaf_ref(2, 2), leaf_ref(4, 1), EMPTY], "forking at {fork_refs}");

@@ -30,7 +30,7 @@ use raylab_core::{Aabb, Ray, Vec3};
 
 use crate::bvh::Bvh;
 use crate::{Accel, AccelStats, Counters, Hit, Primitives, ValidationError};
-use node::{is_leaf, leaf_blocks, ChildRef, Layout, TriBlock, WideNode, EMPTY};
+use node::{is_leaf, leaf_blocks, node_index, ChildRef, Layout, TriBlock, WideNode, EMPTY, NODE_UNIT};
 
 pub use collapse::LEAF_PRIMS;
 pub use packet::PACKET;
@@ -135,10 +135,10 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
     /// Converts a binary BVH built over `prims`.
     pub fn from_binary<P: Primitives + ?Sized>(bvh: &Bvh, prims: &P, name: &'static str) -> Self {
         const { assert!(W == 4 || W == 8, "wide BVHs are 4 or 8 wide") };
-        let c = collapse::collapse::<P, W>(bvh, prims);
+        let c = collapse::collapse::<P, W, N>(bvh, prims);
         let nodes: Vec<N> = encode(c.nodes, c.root);
         // The root's decoded boxes may round past the scene's bounds: the root box holds them.
-        let root_bounds = if c.root == EMPTY || is_leaf(c.root) { c.root_bounds } else { nodes[c.root as usize].with_decoded(|n| (0..W).filter(|&l| n.child[l] != EMPTY).fold(c.root_bounds, |b, l| b.union(n.child_bounds(l)))) };
+        let root_bounds = if c.root == EMPTY || is_leaf(c.root) { c.root_bounds } else { nodes[index::<W, N>(c.root)].with_decoded(|n| (0..W).filter(|&l| n.child[l] != EMPTY).fold(c.root_bounds, |b, l| b.union(n.child_bounds(l)))) };
         let w = Self { nodes, blocks: c.blocks, root: c.root, root_bounds, name, build_ms: 0.0, primitives: prims.len(), spatial_splits: bvh.spatial_splits, kernel: Kernel::detect(W), packet_kernel: Kernel::detect_packets(W), prefetch_children: false };
         w.with_prefetch(Prefetch::Auto)
     }
@@ -156,6 +156,18 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
     /// Whether single rays prefetch the children they enter and push ([`Prefetch`]).
     pub fn prefetches_children(&self) -> bool {
         self.prefetch_children
+    }
+
+    /// The node interior reference `r` points at: at `r` [`NODE_UNIT`]s from the first,
+    /// found with a shift (see [`NODE_UNIT`]).
+    #[inline(always)]
+    pub(super) fn node(&self, r: ChildRef) -> &N {
+        let at = r as usize * NODE_UNIT;
+        assert!(at + std::mem::size_of::<N>() <= std::mem::size_of_val(&self.nodes[..]), "wide BVH: node reference {r} past the nodes");
+        // SAFETY: within the nodes (checked), at a multiple of `NODE_UNIT` from their start,
+        // which `Layout` types are aligned to; a reference that falls inside a node (only a
+        // broken tree has one) reads plain data, which `Layout` types are.
+        unsafe { &*self.nodes.as_ptr().cast::<u8>().add(at).cast::<N>() }
     }
 
     /// Bytes of nodes and blocks.
@@ -301,9 +313,10 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
         let mut stack = vec![(self.root, self.root_bounds, 1usize)];
         while let Some((r, b, depth)) = stack.pop() {
             f(r, &b, depth);
-            if !is_leaf(r) && entered.get(r as usize).is_some_and(|e| !e) {
-                entered[r as usize] = true;
-                self.nodes[r as usize].with_decoded(|n| {
+            let i = node_index::<N>(r).filter(|_| !is_leaf(r));
+            if let Some(i) = i.filter(|&i| entered.get(i).is_some_and(|e| !e)) {
+                entered[i] = true;
+                self.nodes[i].with_decoded(|n| {
                     for lane in 0..W {
                         if n.child[lane] != EMPTY {
                             stack.push((n.child[lane], n.child_bounds(lane), depth + 1));
@@ -338,8 +351,8 @@ fn encode<const W: usize, N: Layout<W>>(nodes: Vec<WideNode<W>>, root: ChildRef)
     let mut stack = vec![root];
     while let Some(r) = stack.pop() {
         if r != EMPTY && !is_leaf(r) {
-            preorder.push(r as usize);
-            stack.extend(nodes[r as usize].child);
+            preorder.push(index::<W, N>(r));
+            stack.extend(nodes[index::<W, N>(r)].child);
         }
     }
     let mut out: Vec<Option<N>> = vec![None; nodes.len()];
@@ -348,7 +361,7 @@ fn encode<const W: usize, N: Layout<W>>(nodes: Vec<WideNode<W>>, root: ChildRef)
         for lane in 0..W {
             let r = n.child[lane];
             if r != EMPTY && !is_leaf(r) {
-                let widened = out[r as usize].expect("children come first").with_decoded(|c| (0..W).filter(|&l| c.child[l] != EMPTY).fold(n.child_bounds(lane), |b, l| b.union(c.child_bounds(l))));
+                let widened = out[index::<W, N>(r)].expect("children come first").with_decoded(|c| (0..W).filter(|&l| c.child[l] != EMPTY).fold(n.child_bounds(lane), |b, l| b.union(c.child_bounds(l))));
                 n.set(lane, &widened, r);
             }
         }
@@ -356,6 +369,11 @@ fn encode<const W: usize, N: Layout<W>>(nodes: Vec<WideNode<W>>, root: ChildRef)
     }
     // Nodes no traversal reaches (validation reports them) keep their own boxes.
     out.into_iter().zip(&nodes).map(|(e, n)| e.unwrap_or_else(|| N::encode(n))).collect()
+}
+
+/// The index of the node a reference from the collapse points at (always at a node's start).
+fn index<const W: usize, N: Layout<W>>(r: ChildRef) -> usize {
+    node_index::<N>(r).expect("the collapse references nodes at their start")
 }
 
 /// Whether this CPU runs the 16-ray ray-major packet path (`ray_major/avx512.rs`): AVX-512F and VL.
@@ -503,7 +521,10 @@ impl<const W: usize, N: Layout<W>> Accel for WideBvh<W, N> {
                     }
                 }
             } else {
-                let i = r as usize;
+                let Some(i) = node_index::<N>(r) else {
+                    problem = Some(format!("reference {r} falls inside a node"));
+                    return;
+                };
                 if i >= self.nodes.len() || reached[i] {
                     problem = Some(format!("node {i} out of range or reached twice"));
                     return;

@@ -195,7 +195,7 @@ pub(super) fn closest<P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
                 }
             }
         } else {
-            let node = &bvh.nodes[cur as usize];
+            let node = bvh.node(cur);
             // Per child: the rays entering it and their least entry distance.
             let mut entered = [0 as RayMask; W];
             let mut nearest = [f32::INFINITY; W];

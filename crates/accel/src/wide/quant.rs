@@ -54,7 +54,8 @@ fn finite(x: f32) -> f32 {
     x.clamp(f32::MIN, f32::MAX)
 }
 
-impl Layout<8> for QuantNode {
+// SAFETY: f32, u8 and u32 fields only, 96 bytes, `align(32)`.
+unsafe impl Layout<8> for QuantNode {
     const NAME: &'static str = "quantised";
     const EXACT: bool = false;
 

@@ -185,7 +185,7 @@ pub(super) fn prefetch<const W: usize, N: Layout<W>>(bvh: &WideBvh<W, N>, r: Chi
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        let (p, bytes) = if is_leaf(r) { ((&bvh.blocks[super::node::leaf_blocks(r).0] as *const TriBlock).cast::<i8>(), std::mem::size_of::<TriBlock>()) } else { ((&bvh.nodes[r as usize] as *const N).cast::<i8>(), std::mem::size_of::<N>()) };
+        let (p, bytes) = if is_leaf(r) { ((&bvh.blocks[super::node::leaf_blocks(r).0] as *const TriBlock).cast::<i8>(), std::mem::size_of::<TriBlock>()) } else { ((bvh.node(r) as *const N).cast::<i8>(), std::mem::size_of::<N>()) };
         // One prefetch per 64 bytes from the element's start (a last line it may reach
         // into is left out: prefetching it measured no faster).
         for line in (0..bytes).step_by(64) {
@@ -211,7 +211,7 @@ fn any_portable<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const COUN
 /// the nearest, far to near, and returns the nearest; `None` when it enters none.
 #[inline(always)]
 fn enter_closest<const W: usize, N: Layout<W>, const SIMD: bool, const PF: bool>(bvh: &WideBvh<W, N>, cur: ChildRef, rb: &RayBoxes, t_max: f32, stack: &mut [MaybeUninit<Entry>; STACK], sp: &mut usize) -> Option<ChildRef> {
-    let node = &bvh.nodes[cur as usize];
+    let node = bvh.node(cur);
     let mut tnear = [0.0f32; W];
     let mask = node.boxes::<SIMD>(rb, t_max * ROBUST_FAR, &mut tnear);
     if mask == 0 {
@@ -446,7 +446,7 @@ pub(super) fn any<P: Primitives + ?Sized, const W: usize, N: Layout<W>, const SI
                 break;
             }
         } else {
-            let node = &bvh.nodes[cur as usize];
+            let node = bvh.node(cur);
             let mut tnear = [0.0f32; W];
             let mut mask = node.boxes::<SIMD>(&rb, ray.t_max * ROBUST_FAR, &mut tnear);
             if mask != 0 {

@@ -397,7 +397,7 @@ fn closest<V: Vector, P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
                 let mut keys = [0u32; 8];
                 let mut k = 0;
                 let mut scratch = MaybeUninit::uninit();
-                let node = bvh.nodes[cur as usize].decoded(&mut scratch);
+                let node = bvh.node(cur).decoded(&mut scratch);
                 // SAFETY: `W == 8` (the caller's check), so the types are the same.
                 let node8 = unsafe { &*(node as *const WideNode<W>).cast::<WideNode<8>>() };
                 // Children are ordered by the frustum's entry distance (a packet of copies of
@@ -431,7 +431,7 @@ fn closest<V: Vector, P: Primitives + ?Sized, const W: usize, N: Layout<W>, cons
                     insert_sorted(&mut keys, &mut k, (least.to_bits() & !lane_bits) | l as u32);
                 }
                 if k > 0 {
-                    let node = &bvh.nodes[cur as usize];
+                    let node = bvh.node(cur);
                     for &key in keys[1..k].iter().rev() {
                         let l = (key & lane_bits) as usize;
                         prefetch(bvh, node.child(l));
