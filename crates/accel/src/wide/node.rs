@@ -33,7 +33,7 @@ pub const fn node_ref<N>(index: usize) -> ChildRef {
 #[inline]
 pub const fn node_index<N>(r: ChildRef) -> Option<usize> {
     let stride = std::mem::size_of::<N>() / NODE_UNIT;
-    if r as usize % stride == 0 {
+    if (r as usize).is_multiple_of(stride) {
         Some(r as usize / stride)
     } else {
         None
