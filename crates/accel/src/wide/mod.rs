@@ -162,6 +162,7 @@ impl<const W: usize, N: Layout<W>> WideBvh<W, N> {
     /// found with a shift (see [`NODE_UNIT`]).
     #[inline(always)]
     pub(super) fn node(&self, r: ChildRef) -> &N {
+        const { assert!(std::mem::size_of::<N>().is_multiple_of(NODE_UNIT) && std::mem::align_of::<N>() >= NODE_UNIT, "a layout's nodes fill and align to whole reference units") };
         let at = r as usize * NODE_UNIT;
         assert!(at + std::mem::size_of::<N>() <= std::mem::size_of_val(&self.nodes[..]), "wide BVH: node reference {r} past the nodes");
         // SAFETY: within the nodes (checked), at a multiple of `NODE_UNIT` from their start,
